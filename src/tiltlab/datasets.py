@@ -1,0 +1,208 @@
+"""The real-data registry: files, checksums and upstream URLs of the public data
+sets the book uses, and loaders returning validated Recordings.
+
+The registry (``_registry/registry.txt``, pooch format) is generated from the data
+manifest by ``tools/make_registry.py`` and committed; the data are not.
+
+Where the files come from
+-------------------------
+* ``TILTLAB_DATA_DIR`` set: files are read from that local mirror (a folder with the
+  manifest's layout, e.g. ``broad/02_undisturbed_slow_rotation_B.hdf5``); nothing is
+  ever downloaded, and a missing file is an error.
+* otherwise: files are downloaded once from their upstream URLs into a cache
+  (``TILTLAB_CACHE_DIR``, default the OS cache folder) with :mod:`pooch`, unless
+  ``TILTLAB_OFFLINE=1``, in which case a file not already cached is an error.
+
+Every file's SHA-256 is checked against the registry; a mismatch is an error naming
+the file.
+"""
+
+from __future__ import annotations
+
+import functools
+import hashlib
+import json
+import os
+import re
+from importlib import resources
+from pathlib import Path
+
+import xarray as xr
+
+from . import io
+
+__all__ = [
+    "DataError",
+    "registry",
+    "data_dir",
+    "fetch",
+    "broad_trials",
+    "broad_trial_groups",
+    "load_broad_trial",
+    "load_fayat_example",
+    "load_fayat_tumble",
+    "citation",
+]
+
+ENV_DATA_DIR = "TILTLAB_DATA_DIR"
+ENV_CACHE_DIR = "TILTLAB_CACHE_DIR"
+ENV_OFFLINE = "TILTLAB_OFFLINE"
+
+
+class DataError(RuntimeError):
+    """A registered file is missing, cannot be fetched, or fails its checksum."""
+
+
+@functools.cache
+def registry() -> dict[str, dict[str, str]]:
+    """The registry: file name → ``{"sha256", "url", "dataset", "bytes", "license"}``."""
+    base = resources.files("tiltlab") / "_registry"
+    meta = json.loads((base / "datasets.json").read_text())
+    out: dict[str, dict[str, str]] = {}
+    for line in (base / "registry.txt").read_text().splitlines():
+        if not line.strip() or line.startswith("#"):
+            continue
+        name, digest, url = line.split()
+        algo, _, h = digest.partition(":")
+        if algo != "sha256":
+            raise DataError(f"registry entry {name}: unsupported hash {algo!r}")
+        out[name] = {"sha256": h, "url": url, **meta["files"].get(name, {})}
+    return out
+
+
+def citation(dataset: str) -> str:
+    """Citation of a registered data set (``"broad"`` or ``"fayat2021"``)."""
+    meta = json.loads((resources.files("tiltlab") / "_registry" / "datasets.json").read_text())
+    try:
+        return meta["datasets"][dataset]["citation"]
+    except KeyError:
+        raise DataError(f"unknown data set {dataset!r}; known: {sorted(meta['datasets'])}") from None
+
+
+def data_dir() -> Path | None:
+    """The local mirror named by ``TILTLAB_DATA_DIR``, or None."""
+    d = os.environ.get(ENV_DATA_DIR)
+    return Path(d).expanduser().resolve() if d else None
+
+
+def _sha256(path: Path) -> str:
+    h = hashlib.sha256()
+    with open(path, "rb") as f:
+        for chunk in iter(lambda: f.read(1 << 20), b""):
+            h.update(chunk)
+    return h.hexdigest()
+
+
+@functools.lru_cache(maxsize=256)
+def _verified(path: str, size: int, mtime_ns: int, expected: str) -> bool:
+    return _sha256(Path(path)) == expected
+
+
+def verify(path: str | os.PathLike, name: str) -> Path:
+    """Check ``path`` against the registry entry ``name``; return it or raise DataError."""
+    path = Path(path)
+    entry = registry()[name]
+    st = path.stat()
+    if not _verified(str(path), st.st_size, st.st_mtime_ns, entry["sha256"]):
+        raise DataError(
+            f"checksum mismatch for {name} ({path}): its SHA-256 is {_sha256(path)}, the registry says "
+            f"{entry['sha256']}. The file is corrupt, truncated or a different version; delete it "
+            "(or repair the mirror) and fetch it again."
+        )
+    return path
+
+
+def fetch(name: str, *, progressbar: bool = False) -> Path:
+    """Local path of registered file ``name`` (e.g. ``"broad/02_undisturbed_slow_rotation_B.hdf5"``),
+    checksum verified.
+
+    Raises
+    ------
+    DataError
+        Unknown name; file missing from the mirror; offline and not cached; download
+        failure; checksum mismatch.
+    """
+    reg = registry()
+    if name not in reg:
+        raise DataError(f"{name!r} is not in the tiltlab data registry")
+    mirror = data_dir()
+    if mirror is not None:
+        path = mirror / name
+        if not path.is_file():
+            raise DataError(
+                f"{name} is not in the local data mirror {mirror} ({ENV_DATA_DIR}); "
+                f"unset {ENV_DATA_DIR} to download it from {reg[name]['url']}"
+            )
+        return verify(path, name)
+    import pooch
+
+    cache = Path(os.environ.get(ENV_CACHE_DIR) or pooch.os_cache("tiltlab"))
+    target = cache / name
+    if os.environ.get(ENV_OFFLINE, "").strip() not in ("", "0"):
+        if not target.is_file():
+            raise DataError(f"{name} is not cached in {cache} and {ENV_OFFLINE} forbids downloading it")
+        return verify(target, name)
+    try:
+        path = pooch.retrieve(
+            url=reg[name]["url"],
+            known_hash=f"sha256:{reg[name]['sha256']}",
+            fname=Path(name).name,
+            path=cache / Path(name).parent,
+            downloader=pooch.HTTPDownloader(timeout=60, progressbar=progressbar),
+        )
+    except ValueError as exc:  # pooch's hash mismatch
+        raise DataError(f"checksum mismatch for {name} downloaded from {reg[name]['url']}: {exc}") from None
+    except Exception as exc:
+        raise DataError(f"could not download {name} from {reg[name]['url']}: {type(exc).__name__}: {exc}") from None
+    return Path(path)
+
+
+_TRIAL = re.compile(r"^broad/(\d{2})_(.+)\.(hdf5|mat)$")
+
+
+def broad_trials() -> dict[int, str]:
+    """Registered BROAD trials: trial number → registry file name (30 of the 39)."""
+    out = {}
+    for name in registry():
+        m = _TRIAL.match(name)
+        if m:
+            out[int(m.group(1))] = name
+    return dict(sorted(out.items()))
+
+
+def broad_trial_groups() -> dict[int, list[str]]:
+    """Trial number → BROAD's group labels (``undisturbed``, ``rotation``, ``fast`` …), from ``trials.json``."""
+    info = json.loads(fetch("broad/trials.json").read_text())["trials"]
+    out = {}
+    for n, name in broad_trials().items():
+        key = Path(name).stem
+        out[n] = list(info[key]["groups"]) if key in info else []
+    return out
+
+
+def load_broad_trial(trial: int | str) -> xr.Dataset:
+    """Load a BROAD trial by number (e.g. ``2``) or stem (``"02_undisturbed_slow_rotation_B"``).
+
+    Returns a validated Recording with ``acc`` (m/s²), ``gyr`` (rad/s), ``mag`` (µT),
+    ``q_ref`` (optical ground truth, NaN where tracking was lost), ``movement`` and
+    ``opt_pos``; ``fs`` = 285.714… Hz.
+    """
+    trials = broad_trials()
+    if isinstance(trial, str):
+        matches = [n for n, name in trials.items() if Path(name).stem == trial]
+        if not matches:
+            raise DataError(f"no BROAD trial named {trial!r}")
+        trial = matches[0]
+    if trial not in trials:
+        raise DataError(f"BROAD trial {trial} is not available; available: {sorted(trials)}")
+    return io.read_broad(fetch(trials[trial]))
+
+
+def load_fayat_example() -> xr.Dataset:
+    """Fayat et al.'s freely-moving rat head IMU example (100 Hz, g and °/s, no ground truth)."""
+    return io.read_fayat_imu(fetch("fayat2021/example_imu.csv"))
+
+
+def load_fayat_tumble() -> xr.Dataset:
+    """Fayat et al.'s tumble-test recording (300 Hz, sensor still in several orientations)."""
+    return io.read_fayat_tumble(fetch("fayat2021/example_sensor_calibration.csv"))

@@ -1,0 +1,508 @@
+r"""Quaternion kernels (numba) over arrays of unit quaternions.
+
+Conventions (the book's conventions page states them once):
+
+* scalar first: ``q = (w, x, y, z)``;
+* a quaternion rotates **sensor → world**: a vector with sensor coordinates
+  :math:`v_s` has world coordinates :math:`v_w = R(q)\,v_s = q \otimes v_s \otimes q^*`;
+* world z points up, so the tilt (gravity-up direction in the sensor frame) is
+  :math:`g_s = R(q)^\top e_z`;
+* angular velocity is expressed in the sensor frame, so orientation propagates as
+  :math:`\dot q = \tfrac12\, q \otimes (0, \omega)`.
+
+Every public function accepts arrays with any leading shape (``(..., 4)`` for
+quaternions, ``(..., 3)`` for vectors, ``(..., 3, 3)`` for matrices), broadcasts
+its arguments, never modifies its inputs and returns new arrays. The loops run in
+``@njit(cache=True)`` kernels.
+
+References
+----------
+.. [1] J. Solà, "Quaternion kinematics for the error-state Kalman filter",
+   arXiv:1711.02508, 2017.
+.. [2] S. W. Shepperd, "Quaternion from rotation matrix", J. Guidance and Control
+   1(3):223–224, 1978. doi:10.2514/3.55767b
+.. [3] D. Laidig, M. Caruso, A. Cereatti, T. Seel, "BROAD — A Benchmark for Robust
+   Inertial Orientation Estimation", Data 6(7):72, 2021. doi:10.3390/data6070072
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+__all__ = [
+    "identity",
+    "mul",
+    "conj",
+    "inv",
+    "norm",
+    "normalize",
+    "canonical",
+    "rotate",
+    "rotate_inverse",
+    "to_matrix",
+    "from_matrix",
+    "to_rotvec",
+    "from_rotvec",
+    "exp",
+    "log",
+    "gravity",
+    "angle_between",
+    "error_quaternion",
+    "tilt_error",
+    "heading_error",
+    "total_error",
+    "integrate_gyro",
+    "from_scipy",
+    "to_scipy",
+    "random_quaternions",
+]
+
+
+# ---------------------------------------------------------------- kernels
+
+
+@njit(cache=True)
+def _mul_kernel(p, q, out):
+    for i in range(p.shape[0]):
+        pw, px, py, pz = p[i, 0], p[i, 1], p[i, 2], p[i, 3]
+        qw, qx, qy, qz = q[i, 0], q[i, 1], q[i, 2], q[i, 3]
+        out[i, 0] = pw * qw - px * qx - py * qy - pz * qz
+        out[i, 1] = pw * qx + px * qw + py * qz - pz * qy
+        out[i, 2] = pw * qy - px * qz + py * qw + pz * qx
+        out[i, 3] = pw * qz + px * qy - py * qx + pz * qw
+
+
+@njit(cache=True)
+def _rotate_kernel(q, v, inverse, out):
+    # v' = R(q) v (or R(q)^T v) using v' = v + 2 w (u x v) + 2 u x (u x v), u = (x, y, z)
+    for i in range(q.shape[0]):
+        w, x, y, z = q[i, 0], q[i, 1], q[i, 2], q[i, 3]
+        if inverse:
+            x, y, z = -x, -y, -z
+        vx, vy, vz = v[i, 0], v[i, 1], v[i, 2]
+        tx = 2.0 * (y * vz - z * vy)
+        ty = 2.0 * (z * vx - x * vz)
+        tz = 2.0 * (x * vy - y * vx)
+        out[i, 0] = vx + w * tx + (y * tz - z * ty)
+        out[i, 1] = vy + w * ty + (z * tx - x * tz)
+        out[i, 2] = vz + w * tz + (x * ty - y * tx)
+
+
+@njit(cache=True)
+def _to_matrix_kernel(q, out):
+    for i in range(q.shape[0]):
+        w, x, y, z = q[i, 0], q[i, 1], q[i, 2], q[i, 3]
+        out[i, 0, 0] = 1.0 - 2.0 * (y * y + z * z)
+        out[i, 0, 1] = 2.0 * (x * y - w * z)
+        out[i, 0, 2] = 2.0 * (x * z + w * y)
+        out[i, 1, 0] = 2.0 * (x * y + w * z)
+        out[i, 1, 1] = 1.0 - 2.0 * (x * x + z * z)
+        out[i, 1, 2] = 2.0 * (y * z - w * x)
+        out[i, 2, 0] = 2.0 * (x * z - w * y)
+        out[i, 2, 1] = 2.0 * (y * z + w * x)
+        out[i, 2, 2] = 1.0 - 2.0 * (x * x + y * y)
+
+
+@njit(cache=True)
+def _from_matrix_kernel(m, out):
+    # Shepperd's method: pivot on the largest of (trace, diagonal) for stability
+    for i in range(m.shape[0]):
+        m00, m01, m02 = m[i, 0, 0], m[i, 0, 1], m[i, 0, 2]
+        m10, m11, m12 = m[i, 1, 0], m[i, 1, 1], m[i, 1, 2]
+        m20, m21, m22 = m[i, 2, 0], m[i, 2, 1], m[i, 2, 2]
+        tr = m00 + m11 + m22
+        if tr >= m00 and tr >= m11 and tr >= m22:
+            s = 2.0 * np.sqrt(1.0 + tr)
+            w = 0.25 * s
+            x = (m21 - m12) / s
+            y = (m02 - m20) / s
+            z = (m10 - m01) / s
+        elif m00 >= m11 and m00 >= m22:
+            s = 2.0 * np.sqrt(1.0 + m00 - m11 - m22)
+            w = (m21 - m12) / s
+            x = 0.25 * s
+            y = (m01 + m10) / s
+            z = (m02 + m20) / s
+        elif m11 >= m22:
+            s = 2.0 * np.sqrt(1.0 + m11 - m00 - m22)
+            w = (m02 - m20) / s
+            x = (m01 + m10) / s
+            y = 0.25 * s
+            z = (m12 + m21) / s
+        else:
+            s = 2.0 * np.sqrt(1.0 + m22 - m00 - m11)
+            w = (m10 - m01) / s
+            x = (m02 + m20) / s
+            y = (m12 + m21) / s
+            z = 0.25 * s
+        n = np.sqrt(w * w + x * x + y * y + z * z)
+        if w < 0.0:
+            n = -n
+        out[i, 0] = w / n
+        out[i, 1] = x / n
+        out[i, 2] = y / n
+        out[i, 3] = z / n
+
+
+@njit(cache=True)
+def _to_rotvec_kernel(q, out):
+    for i in range(q.shape[0]):
+        w, x, y, z = q[i, 0], q[i, 1], q[i, 2], q[i, 3]
+        if w < 0.0:
+            w, x, y, z = -w, -x, -y, -z
+        s = np.sqrt(x * x + y * y + z * z)
+        if s < 1e-6:
+            # theta / s = 2 atan(s / w) / s, Taylor series in (s / w)
+            r = s / w
+            f = 2.0 / w * (1.0 - r * r / 3.0 + r * r * r * r / 5.0)
+        else:
+            f = 2.0 * np.arctan2(s, w) / s
+        out[i, 0] = f * x
+        out[i, 1] = f * y
+        out[i, 2] = f * z
+
+
+@njit(cache=True)
+def _from_rotvec_kernel(r, out):
+    for i in range(r.shape[0]):
+        rx, ry, rz = r[i, 0], r[i, 1], r[i, 2]
+        th2 = rx * rx + ry * ry + rz * rz
+        th = np.sqrt(th2)
+        if th < 1e-4:
+            # sin(th/2)/th and cos(th/2) by series (error < 1e-20)
+            f = 0.5 - th2 / 48.0 + th2 * th2 / 3840.0
+            c = 1.0 - th2 / 8.0 + th2 * th2 / 384.0
+        else:
+            f = np.sin(0.5 * th) / th
+            c = np.cos(0.5 * th)
+        out[i, 0] = c
+        out[i, 1] = f * rx
+        out[i, 2] = f * ry
+        out[i, 3] = f * rz
+
+
+@njit(cache=True)
+def _gravity_kernel(q, out):
+    for i in range(q.shape[0]):
+        w, x, y, z = q[i, 0], q[i, 1], q[i, 2], q[i, 3]
+        out[i, 0] = 2.0 * (x * z - w * y)
+        out[i, 1] = 2.0 * (y * z + w * x)
+        out[i, 2] = w * w - x * x - y * y + z * z
+
+
+@njit(cache=True)
+def _error_angles_kernel(p, q, out):
+    # columns: total, heading, inclination of the Earth-frame error e = p ⊗ q⁻¹
+    for i in range(p.shape[0]):
+        pw, px, py, pz = p[i, 0], p[i, 1], p[i, 2], p[i, 3]
+        qw, qx, qy, qz = q[i, 0], -q[i, 1], -q[i, 2], -q[i, 3]
+        w = pw * qw - px * qx - py * qy - pz * qz
+        x = pw * qx + px * qw + py * qz - pz * qy
+        y = pw * qy - px * qz + py * qw + pz * qx
+        z = pw * qz + px * qy - py * qx + pz * qw
+        aw = abs(w)
+        out[i, 0] = 2.0 * np.arctan2(np.sqrt(x * x + y * y + z * z), aw)
+        if aw == 0.0 and z == 0.0:
+            out[i, 1] = 0.0  # heading undefined for a pure 180° tilt: no heading part
+        else:
+            out[i, 1] = 2.0 * np.arctan2(abs(z), aw)
+        out[i, 2] = 2.0 * np.arctan2(np.sqrt(x * x + y * y), np.sqrt(w * w + z * z))
+
+
+@njit(cache=True)
+def _angle_between_kernel(u, v, out):
+    for i in range(u.shape[0]):
+        cx = u[i, 1] * v[i, 2] - u[i, 2] * v[i, 1]
+        cy = u[i, 2] * v[i, 0] - u[i, 0] * v[i, 2]
+        cz = u[i, 0] * v[i, 1] - u[i, 1] * v[i, 0]
+        d = u[i, 0] * v[i, 0] + u[i, 1] * v[i, 1] + u[i, 2] * v[i, 2]
+        out[i] = np.arctan2(np.sqrt(cx * cx + cy * cy + cz * cz), d)
+
+
+@njit(cache=True)
+def _integrate_kernel(omega, dt, q0, out):
+    # q_{k+1} = q_k ⊗ exp(ω_k dt / 2): exact for ω constant over each step
+    w, x, y, z = q0[0], q0[1], q0[2], q0[3]
+    out[0, 0], out[0, 1], out[0, 2], out[0, 3] = w, x, y, z
+    for k in range(omega.shape[0] - 1):
+        rx, ry, rz = omega[k, 0] * dt, omega[k, 1] * dt, omega[k, 2] * dt
+        th2 = rx * rx + ry * ry + rz * rz
+        th = np.sqrt(th2)
+        if th < 1e-4:
+            f = 0.5 - th2 / 48.0 + th2 * th2 / 3840.0
+            c = 1.0 - th2 / 8.0 + th2 * th2 / 384.0
+        else:
+            f = np.sin(0.5 * th) / th
+            c = np.cos(0.5 * th)
+        dw, dx, dy, dz = c, f * rx, f * ry, f * rz
+        nw = w * dw - x * dx - y * dy - z * dz
+        nx = w * dx + x * dw + y * dz - z * dy
+        ny = w * dy - x * dz + y * dw + z * dx
+        nz = w * dz + x * dy - y * dx + z * dw
+        n = np.sqrt(nw * nw + nx * nx + ny * ny + nz * nz)
+        w, x, y, z = nw / n, nx / n, ny / n, nz / n
+        out[k + 1, 0], out[k + 1, 1], out[k + 1, 2], out[k + 1, 3] = w, x, y, z
+
+
+# ---------------------------------------------------------------- wrappers
+
+
+def _as2d(a: np.ndarray, width: int) -> np.ndarray:
+    return np.ascontiguousarray(a.reshape(-1, width), dtype=np.float64)
+
+
+def _check_last(a: np.ndarray, width: int, name: str) -> None:
+    if a.ndim == 0 or a.shape[-1] != width:
+        raise ValueError(f"{name} must have last dimension {width}, got shape {a.shape}")
+
+
+def identity(n: int | None = None) -> np.ndarray:
+    """The identity quaternion (1, 0, 0, 0), or ``n`` of them."""
+    if n is None:
+        return np.array([1.0, 0.0, 0.0, 0.0])
+    out = np.zeros((n, 4))
+    out[:, 0] = 1.0
+    return out
+
+
+def mul(p, q) -> np.ndarray:
+    r"""Hamilton product :math:`p \otimes q` (broadcast over leading dimensions).
+
+    With sensor → world quaternions, ``mul(p, q)`` applies ``q`` first, then ``p``.
+    """
+    p, q = np.asarray(p, float), np.asarray(q, float)
+    _check_last(p, 4, "p")
+    _check_last(q, 4, "q")
+    p, q = np.broadcast_arrays(p, q)
+    shape = p.shape
+    out = np.empty((int(np.prod(shape[:-1], dtype=np.int64)), 4))
+    _mul_kernel(_as2d(p, 4), _as2d(q, 4), out)
+    return out.reshape(shape)
+
+
+def conj(q) -> np.ndarray:
+    """Conjugate (w, −x, −y, −z): the inverse of a unit quaternion."""
+    q = np.array(q, dtype=float)
+    _check_last(q, 4, "q")
+    q[..., 1:] *= -1.0
+    return q
+
+
+def inv(q) -> np.ndarray:
+    """Inverse :math:`q^* / \\|q\\|^2` (equals :func:`conj` for unit quaternions)."""
+    q = np.asarray(q, float)
+    return conj(q) / np.sum(q * q, axis=-1, keepdims=True)
+
+
+def norm(q) -> np.ndarray:
+    """Euclidean norm over the last axis."""
+    return np.linalg.norm(np.asarray(q, float), axis=-1)
+
+
+def normalize(q) -> np.ndarray:
+    """Unit quaternions; a zero quaternion is an error."""
+    q = np.asarray(q, float)
+    _check_last(q, 4, "q")
+    n = np.linalg.norm(q, axis=-1, keepdims=True)
+    if np.any(n == 0):
+        raise ValueError("cannot normalise a zero quaternion")
+    return q / n
+
+
+def canonical(q) -> np.ndarray:
+    """The representative with w ≥ 0 (q and −q are the same rotation)."""
+    q = np.asarray(q, float)
+    return np.where(q[..., :1] < 0, -q, q)
+
+
+def rotate(q, v) -> np.ndarray:
+    r"""Rotate sensor-frame vectors to the world frame: :math:`R(q)\,v`."""
+    return _rotate(q, v, False)
+
+
+def rotate_inverse(q, v) -> np.ndarray:
+    r"""Rotate world-frame vectors to the sensor frame: :math:`R(q)^\top v`."""
+    return _rotate(q, v, True)
+
+
+def _rotate(q, v, inverse: bool) -> np.ndarray:
+    q, v = np.asarray(q, float), np.asarray(v, float)
+    _check_last(q, 4, "q")
+    _check_last(v, 3, "v")
+    lead = np.broadcast_shapes(q.shape[:-1], v.shape[:-1])
+    qb = np.broadcast_to(q, lead + (4,))
+    vb = np.broadcast_to(v, lead + (3,))
+    out = np.empty((int(np.prod(lead, dtype=np.int64)), 3))
+    _rotate_kernel(_as2d(qb, 4), _as2d(vb, 3), inverse, out)
+    return out.reshape(lead + (3,))
+
+
+def to_matrix(q) -> np.ndarray:
+    """Rotation matrices R(q), shape (..., 3, 3), mapping sensor to world coordinates."""
+    q = np.asarray(q, float)
+    _check_last(q, 4, "q")
+    out = np.empty((int(np.prod(q.shape[:-1], dtype=np.int64)), 3, 3))
+    _to_matrix_kernel(_as2d(q, 4), out)
+    return out.reshape(q.shape[:-1] + (3, 3))
+
+
+def from_matrix(m) -> np.ndarray:
+    """Unit quaternions (w ≥ 0) from rotation matrices (Shepperd's method [2]_)."""
+    m = np.asarray(m, float)
+    if m.shape[-2:] != (3, 3):
+        raise ValueError(f"m must have shape (..., 3, 3), got {m.shape}")
+    out = np.empty((int(np.prod(m.shape[:-2], dtype=np.int64)), 4))
+    _from_matrix_kernel(np.ascontiguousarray(m.reshape(-1, 3, 3)), out)
+    return out.reshape(m.shape[:-2] + (4,))
+
+
+def to_rotvec(q) -> np.ndarray:
+    """Rotation vectors (axis × angle, angle in [0, π]) of unit quaternions."""
+    q = np.asarray(q, float)
+    _check_last(q, 4, "q")
+    out = np.empty((int(np.prod(q.shape[:-1], dtype=np.int64)), 3))
+    _to_rotvec_kernel(_as2d(q, 4), out)
+    return out.reshape(q.shape[:-1] + (3,))
+
+
+def from_rotvec(r) -> np.ndarray:
+    r"""Unit quaternions :math:`(\cos\tfrac{\theta}{2}, \sin\tfrac{\theta}{2}\,\hat r)` from rotation vectors."""
+    r = np.asarray(r, float)
+    _check_last(r, 3, "r")
+    out = np.empty((int(np.prod(r.shape[:-1], dtype=np.int64)), 4))
+    _from_rotvec_kernel(_as2d(r, 3), out)
+    return out.reshape(r.shape[:-1] + (4,))
+
+
+def exp(v) -> np.ndarray:
+    r"""Exponential of pure quaternions :math:`(0, v)`: :math:`\exp(v) = (\cos\|v\|, \sin\|v\|\,\hat v)`.
+
+    Note ``exp(r / 2) == from_rotvec(r)``.
+    """
+    return from_rotvec(2.0 * np.asarray(v, float))
+
+
+def log(q) -> np.ndarray:
+    """Logarithm of unit quaternions as the vector part (``to_rotvec(q) / 2``)."""
+    return 0.5 * to_rotvec(q)
+
+
+def gravity(q) -> np.ndarray:
+    r"""Tilt: the gravity-up direction in the sensor frame, :math:`g_s = R(q)^\top e_z`.
+
+    For a sensor at rest, this is the direction of the accelerometer reading
+    (the specific force points up).
+    """
+    q = np.asarray(q, float)
+    _check_last(q, 4, "q")
+    out = np.empty((int(np.prod(q.shape[:-1], dtype=np.int64)), 3))
+    _gravity_kernel(_as2d(q, 4), out)
+    return out.reshape(q.shape[:-1] + (3,))
+
+
+def angle_between(u, v) -> np.ndarray:
+    """Angle (rad) between vectors, computed as atan2(‖u×v‖, u·v) (accurate near 0 and π)."""
+    u, v = np.asarray(u, float), np.asarray(v, float)
+    _check_last(u, 3, "u")
+    _check_last(v, 3, "v")
+    lead = np.broadcast_shapes(u.shape[:-1], v.shape[:-1])
+    out = np.empty(int(np.prod(lead, dtype=np.int64)))
+    _angle_between_kernel(_as2d(np.broadcast_to(u, lead + (3,)), 3), _as2d(np.broadcast_to(v, lead + (3,)), 3), out)
+    return out.reshape(lead)
+
+
+def error_quaternion(q_est, q_ref) -> np.ndarray:
+    r"""Earth-frame error quaternion :math:`e = q_{est} \otimes q_{ref}^{-1}` (BROAD's definition [3]_)."""
+    return mul(q_est, conj(q_ref))
+
+
+def _error_angles(q_est, q_ref) -> np.ndarray:
+    p, q = np.asarray(q_est, float), np.asarray(q_ref, float)
+    _check_last(p, 4, "q_est")
+    _check_last(q, 4, "q_ref")
+    p, q = np.broadcast_arrays(p, q)
+    out = np.empty((int(np.prod(p.shape[:-1], dtype=np.int64)), 3))
+    _error_angles_kernel(_as2d(p, 4), _as2d(q, 4), out)
+    return out.reshape(p.shape[:-1] + (3,))
+
+
+def total_error(q_est, q_ref) -> np.ndarray:
+    r"""Total orientation error (rad): the angle of :math:`e = q_{est} \otimes q_{ref}^{-1}`, in [0, π]."""
+    return _error_angles(q_est, q_ref)[..., 0]
+
+
+def heading_error(q_est, q_ref) -> np.ndarray:
+    r"""Heading error (rad): the angle of the rotation about world z in the heading–inclination
+    decomposition of the Earth-frame error, :math:`2\,\mathrm{atan2}(|e_z|, |e_w|)`, in [0, π]."""
+    return _error_angles(q_est, q_ref)[..., 1]
+
+
+def tilt_error(q_est, q_ref) -> np.ndarray:
+    r"""Tilt (inclination) error (rad): :math:`2\arccos\sqrt{e_w^2 + e_z^2}` of the Earth-frame error.
+
+    Equal to the angle between the two gravity directions in the sensor frame,
+    ``angle_between(gravity(q_est), gravity(q_ref))``, and to BROAD's inclination
+    error [3]_. Computed as :math:`2\,\mathrm{atan2}(\sqrt{e_x^2+e_y^2}, \sqrt{e_w^2+e_z^2})`
+    for accuracy near zero.
+    """
+    return _error_angles(q_est, q_ref)[..., 2]
+
+
+def integrate_gyro(omega, fs: float, q0=None) -> np.ndarray:
+    r"""Integrate sensor-frame angular velocity (rad/s) into orientations.
+
+    :math:`q_{k+1} = q_k \otimes \exp(\omega_k\,\Delta t / 2)`, exact when ω is constant
+    over each sampling interval (zero-order hold).
+
+    Parameters
+    ----------
+    omega : array_like, shape (N, 3)
+        Angular velocity in rad/s, sensor frame.
+    fs : float
+        Sampling rate (Hz); mandatory.
+    q0 : array_like, shape (4,), optional
+        Initial orientation (default identity).
+
+    Returns
+    -------
+    numpy.ndarray, shape (N, 4)
+        ``q[0] = q0``; ``q[k]`` is the orientation after ``k`` steps.
+    """
+    if fs is None or not np.isfinite(fs) or fs <= 0:
+        raise ValueError(f"fs must be a positive number of Hz, got {fs!r}")
+    omega = np.ascontiguousarray(omega, dtype=float)
+    _check_last(omega, 3, "omega")
+    if omega.ndim != 2:
+        raise ValueError(f"omega must have shape (N, 3), got {omega.shape}")
+    q0 = identity() if q0 is None else normalize(np.asarray(q0, float))
+    out = np.empty((omega.shape[0], 4))
+    if omega.shape[0]:
+        _integrate_kernel(omega, 1.0 / fs, q0, out)
+    return out
+
+
+def from_scipy(rot) -> np.ndarray:
+    """Scalar-first quaternions from a :class:`scipy.spatial.transform.Rotation`.
+
+    scipy's ``as_quat()`` is scalar-last; this converts explicitly.
+    """
+    return np.asarray(rot.as_quat(scalar_first=True))
+
+
+def to_scipy(q):
+    """A :class:`scipy.spatial.transform.Rotation` from scalar-first quaternions."""
+    from scipy.spatial.transform import Rotation
+
+    return Rotation.from_quat(np.asarray(q, float), scalar_first=True)
+
+
+def random_quaternions(n: int, rng: np.random.Generator | int | None = None) -> np.ndarray:
+    """``n`` uniformly distributed unit quaternions (Shoemake's method), w ≥ 0."""
+    rng = np.random.default_rng(rng)
+    u1, u2, u3 = rng.random((3, n))
+    a, b = np.sqrt(1.0 - u1), np.sqrt(u1)
+    q = np.column_stack(
+        [a * np.sin(2 * np.pi * u2), a * np.cos(2 * np.pi * u2), b * np.sin(2 * np.pi * u3), b * np.cos(2 * np.pi * u3)]
+    )
+    return canonical(q)

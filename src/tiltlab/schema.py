@@ -1,0 +1,343 @@
+"""The Recording: tiltlab's data contract for inertial recordings.
+
+A Recording is an :class:`xarray.Dataset` with
+
+* dimensions ``time`` (samples), ``axis`` (``x, y, z``) and, where present, ``quat``
+  (``w, x, y, z``);
+* coordinate ``time`` in seconds (``units='s'``);
+* variables ``acc`` (time, axis) and ``gyr`` (time, axis), optional ``mag``
+  (time, axis), ``temp`` (time), ``q_ref`` (time, quat: ground-truth orientation,
+  unit, scalar-first, sensor → world) and any extra per-sample variables
+  (e.g. a boolean ``movement`` mask);
+* mandatory dataset attribute ``fs`` (Hz), ``frame`` (the frame the vectors are
+  expressed in, normally ``"sensor"``), and provenance attributes (``source``,
+  ``sensor``, ``subject``, ``session``);
+* a ``units`` attribute on every physical variable.
+
+:func:`make_recording` builds one from arrays and :func:`validate` checks one,
+raising :class:`RecordingError` with a message naming the problem.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import Any
+
+import numpy as np
+import xarray as xr
+
+from . import units as _units
+
+__all__ = [
+    "AXES",
+    "QUAT",
+    "RecordingError",
+    "make_recording",
+    "validate",
+    "to_units",
+    "VECTOR_VARS",
+]
+
+AXES: tuple[str, str, str] = ("x", "y", "z")
+QUAT: tuple[str, str, str, str] = ("w", "x", "y", "z")
+
+#: Per-sample 3-vector variables and the physical quantity each holds.
+VECTOR_VARS: dict[str, str] = {
+    "acc": "acceleration",
+    "gyr": "angular_velocity",
+    "mag": "magnetic_field",
+}
+_QUANTITY = {**VECTOR_VARS, "temp": "temperature", "q_ref": "dimensionless"}
+_PROVENANCE = ("source", "sensor", "subject", "session")
+
+
+class RecordingError(ValueError):
+    """A Recording breaks the data contract; the message names what is wrong."""
+
+
+def make_recording(
+    acc,
+    gyr,
+    fs: float,
+    *,
+    acc_units: str = "g",
+    gyr_units: str = "deg/s",
+    mag=None,
+    mag_units: str = "uT",
+    temp=None,
+    temp_units: str = "degC",
+    q_ref=None,
+    time=None,
+    t0: float = 0.0,
+    frame: str = "sensor",
+    extra: Mapping[str, Any] | None = None,
+    attrs: Mapping[str, Any] | None = None,
+    validate_result: bool = True,
+    **validate_kwargs,
+) -> xr.Dataset:
+    """Build a validated Recording from arrays.
+
+    Parameters
+    ----------
+    acc, gyr : array_like, shape (N, 3)
+        Accelerometer and gyroscope samples in ``acc_units`` / ``gyr_units``.
+    fs : float
+        Sampling rate in Hz. Mandatory: tiltlab never assumes a default.
+    mag : array_like, shape (N, 3), optional
+        Magnetometer samples in ``mag_units``.
+    temp : array_like, shape (N,), optional
+        Sensor temperature in ``temp_units``.
+    q_ref : array_like, shape (N, 4), optional
+        Ground-truth orientation, unit quaternions (w, x, y, z), sensor → world.
+    time : array_like, shape (N,), optional
+        Sample times in seconds; default ``t0 + arange(N) / fs``.
+    frame : str
+        Frame in which the vectors are expressed (default ``"sensor"``).
+    extra : mapping, optional
+        Additional per-sample variables, ``name -> array`` (first dim = time) or
+        ``name -> (dims, array, attrs)``.
+    attrs : mapping, optional
+        Dataset attributes (provenance: ``source``, ``sensor``, ``subject``, ``session`` …).
+    validate_result : bool
+        Run :func:`validate` on the result (default True).
+    **validate_kwargs
+        Passed to :func:`validate`.
+
+    Returns
+    -------
+    xarray.Dataset
+        The Recording.
+    """
+    if fs is None:
+        raise RecordingError("fs (sampling rate, Hz) is mandatory; tiltlab never assumes a default")
+    fs = float(fs)
+    if not np.isfinite(fs) or fs <= 0:
+        raise RecordingError(f"fs must be a positive finite number of Hz, got {fs!r}")
+    acc = np.asarray(acc, dtype=float)
+    gyr = np.asarray(gyr, dtype=float)
+    if acc.ndim != 2 or acc.shape[1] != 3:
+        raise RecordingError(f"acc must have shape (N, 3), got {acc.shape}")
+    if gyr.ndim != 2 or gyr.shape[1] != 3:
+        raise RecordingError(f"gyr must have shape (N, 3), got {gyr.shape}")
+    if acc.shape[0] != gyr.shape[0]:
+        raise RecordingError(
+            f"acc and gyr lengths differ: {acc.shape[0]} vs {gyr.shape[0]} samples"
+        )
+    n = acc.shape[0]
+    if time is None:
+        time = t0 + np.arange(n) / fs
+    time = np.asarray(time, dtype=float)
+    if time.shape != (n,):
+        raise RecordingError(f"time must have shape ({n},), got {time.shape}")
+
+    data_vars: dict[str, Any] = {
+        "acc": (("time", "axis"), acc.copy(), {"units": _units.normalise_unit(acc_units), "long_name": "acceleration (specific force)"}),
+        "gyr": (("time", "axis"), gyr.copy(), {"units": _units.normalise_unit(gyr_units), "long_name": "angular velocity"}),
+    }
+    if mag is not None:
+        data_vars["mag"] = (("time", "axis"), np.array(mag, dtype=float), {"units": _units.normalise_unit(mag_units), "long_name": "magnetic field"})
+    if temp is not None:
+        data_vars["temp"] = (("time",), np.array(temp, dtype=float), {"units": _units.normalise_unit(temp_units), "long_name": "sensor temperature"})
+    if q_ref is not None:
+        data_vars["q_ref"] = (("time", "quat"), np.array(q_ref, dtype=float), {"units": "1", "long_name": "reference orientation, sensor to world", "frame": "sensor->world"})
+    for name, value in (extra or {}).items():
+        if isinstance(value, tuple):
+            data_vars[name] = value
+        else:
+            arr = np.array(value)
+            dims = ("time",) if arr.ndim == 1 else ("time", "axis") if arr.shape[1:] == (3,) else None
+            if dims is None:
+                raise RecordingError(f"extra variable {name!r}: give (dims, array, attrs) for shape {arr.shape}")
+            data_vars[name] = (dims, arr)
+    ds = xr.Dataset(
+        data_vars,
+        coords={"time": ("time", time, {"units": "s"}), "axis": list(AXES), **({"quat": list(QUAT)} if q_ref is not None else {})},
+        attrs={"fs": fs, "frame": frame, **dict(attrs or {})},
+    )
+    if validate_result:
+        validate(ds, **validate_kwargs)
+    return ds
+
+
+def _check_vector_var(ds: xr.Dataset, name: str, allow_nan: bool) -> None:
+    da = ds[name]
+    if da.dims != ("time", "axis"):
+        raise RecordingError(f"{name!r} must have dims ('time', 'axis'), got {da.dims}")
+    if da.sizes["axis"] != 3:
+        raise RecordingError(f"{name!r} must have 3 axes, got {da.sizes['axis']}")
+    _check_finite(da, name, allow_nan)
+
+
+def _check_finite(da: xr.DataArray, name: str, allow_nan: bool) -> None:
+    values = np.asarray(da.values, dtype=float)
+    bad = ~np.isfinite(values)
+    if allow_nan:
+        bad &= ~np.isnan(values)  # NaN marks a missing sample; inf is never allowed
+    if bad.any():
+        idx = np.argwhere(bad)[0]
+        raise RecordingError(
+            f"{name!r} has {int(bad.sum())} non-finite values (first at index {tuple(int(i) for i in idx)})"
+            + ("" if allow_nan else "; NaN is not allowed here (pass allow_nan=True to accept gaps)")
+        )
+
+
+def _check_units(da: xr.DataArray, name: str) -> None:
+    u = da.attrs.get("units")
+    if u is None:
+        raise RecordingError(f"{name!r} has no 'units' attribute")
+    try:
+        canon = _units.normalise_unit(u)
+    except _units.UnitsError as exc:
+        raise RecordingError(f"{name!r}: {exc}") from None
+    q = _QUANTITY.get(name)
+    if q is not None and canon not in _units.UNITS[q]:
+        raise RecordingError(
+            f"{name!r} has units {u!r}, which do not measure {q.replace('_', ' ')} "
+            f"(expected one of {_units.UNITS[q]})"
+        )
+
+
+def validate(
+    ds: xr.Dataset,
+    *,
+    allow_nan: bool = False,
+    max_jitter: float = 0.35,
+    quat_atol: float = 1e-6,
+    check_units: bool = True,
+) -> xr.Dataset:
+    """Check that ``ds`` satisfies the Recording contract.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        Candidate Recording.
+    allow_nan : bool
+        Accept NaN (missing samples) in data variables; infinities are always rejected.
+    max_jitter : float
+        Largest accepted deviation of a sampling interval from ``1/fs``, as a fraction of
+        ``1/fs``. The default (0.35) accepts the Fayat example, whose 300 → 100 Hz
+        down-sampling left 27 intervals of 2/300 s, and rejects any dropped sample.
+    quat_atol : float
+        Tolerance on ``| ‖q‖ − 1 |`` for ``q_ref``.
+    check_units : bool
+        Run the gyroscope unit plausibility check (:func:`tiltlab.units.check_gyro_units`).
+
+    Returns
+    -------
+    xarray.Dataset
+        ``ds`` itself (unchanged), so that calls can be chained.
+
+    Raises
+    ------
+    RecordingError
+        With a message naming the first problem found.
+    """
+    if not isinstance(ds, xr.Dataset):
+        raise RecordingError(f"a Recording is an xarray.Dataset, got {type(ds).__name__}")
+    fs = ds.attrs.get("fs")
+    if fs is None:
+        raise RecordingError("attribute 'fs' (sampling rate, Hz) is missing; it is mandatory")
+    try:
+        fs = float(fs)
+    except (TypeError, ValueError):
+        raise RecordingError(f"attribute 'fs' must be a number of Hz, got {fs!r}") from None
+    if not np.isfinite(fs) or fs <= 0:
+        raise RecordingError(f"attribute 'fs' must be positive and finite, got {fs!r}")
+    if "frame" not in ds.attrs:
+        raise RecordingError("attribute 'frame' is missing (normally 'sensor')")
+    for v in ("acc", "gyr"):
+        if v not in ds:
+            raise RecordingError(f"variable {v!r} is missing")
+    if "time" not in ds.coords:
+        raise RecordingError("coordinate 'time' is missing")
+    if "axis" not in ds.coords or tuple(str(a) for a in ds["axis"].values) != AXES:
+        raise RecordingError(f"coordinate 'axis' must be {AXES}")
+    n_acc, n_gyr = ds["acc"].sizes.get("time"), ds["gyr"].sizes.get("time")
+    if n_acc != n_gyr:
+        raise RecordingError(f"acc and gyr lengths differ: {n_acc} vs {n_gyr} samples")
+
+    t = np.asarray(ds["time"].values, dtype=float)
+    if t.ndim != 1:
+        raise RecordingError("coordinate 'time' must be one-dimensional")
+    if not np.all(np.isfinite(t)):
+        raise RecordingError("coordinate 'time' has non-finite values")
+    if t.size >= 2:
+        dt = np.diff(t)
+        if np.any(dt <= 0):
+            i = int(np.argmax(dt <= 0))
+            raise RecordingError(f"time is not strictly increasing (at sample {i + 1}: {t[i]} → {t[i + 1]} s)")
+        jitter = np.abs(dt * fs - 1.0)
+        if jitter.max() > max_jitter:
+            i = int(np.argmax(jitter))
+            raise RecordingError(
+                f"time is irregular: interval {i}→{i + 1} is {dt[i]:.6g} s where 1/fs = {1 / fs:.6g} s "
+                f"(deviation {jitter[i]:.2f} sample periods > max_jitter={max_jitter}); "
+                "a dropped or duplicated sample, or a wrong fs"
+            )
+    if ds["time"].attrs.get("units", "s") != "s":
+        raise RecordingError(f"coordinate 'time' must be in seconds, got units {ds['time'].attrs['units']!r}")
+
+    for name in VECTOR_VARS:
+        if name in ds:
+            _check_vector_var(ds, name, allow_nan)
+            _check_units(ds[name], name)
+    if "temp" in ds:
+        if ds["temp"].dims != ("time",):
+            raise RecordingError(f"'temp' must have dims ('time',), got {ds['temp'].dims}")
+        _check_finite(ds["temp"], "temp", allow_nan)
+        _check_units(ds["temp"], "temp")
+    if "q_ref" in ds:
+        q = ds["q_ref"]
+        if q.dims != ("time", "quat"):
+            raise RecordingError(f"'q_ref' must have dims ('time', 'quat'), got {q.dims}")
+        if tuple(str(c) for c in ds["quat"].values) != QUAT:
+            raise RecordingError(f"coordinate 'quat' must be {QUAT} (scalar first)")
+        _check_finite(q, "q_ref", allow_nan)
+        qv = np.asarray(q.values, dtype=float)
+        norms = np.linalg.norm(qv, axis=1)
+        bad = np.abs(norms - 1.0) > quat_atol
+        if allow_nan:
+            bad &= np.isfinite(norms)
+        if bad.any():
+            i = int(np.argmax(bad))
+            raise RecordingError(
+                f"'q_ref' has {int(bad.sum())} non-unit quaternions (first at sample {i}, norm {norms[i]:.6g})"
+            )
+    for name, da in ds.data_vars.items():
+        if "time" in da.dims and da.dims[0] != "time":
+            raise RecordingError(f"variable {name!r}: 'time' must be the first dimension, got {da.dims}")
+
+    if check_units:
+        acc = np.asarray(ds["acc"].values, dtype=float)
+        gyr = np.asarray(ds["gyr"].values, dtype=float)
+        if allow_nan:
+            keep = np.isfinite(acc).all(axis=1) & np.isfinite(gyr).all(axis=1)
+            acc, gyr = acc[keep], gyr[keep]
+        try:
+            _units.check_gyro_units(gyr, ds["gyr"].attrs["units"], acc, fs)
+        except _units.UnitsError as exc:
+            raise RecordingError(str(exc)) from None
+    return ds
+
+
+def to_units(ds: xr.Dataset, **targets: str) -> xr.Dataset:
+    """Return a copy of ``ds`` with variables converted, e.g. ``to_units(rec, acc='m/s^2', gyr='rad/s')``.
+
+    Attributes are kept and each converted variable's ``units`` attribute is updated.
+    """
+    out = ds.copy()
+    for name, dst in targets.items():
+        if name not in ds:
+            raise RecordingError(f"variable {name!r} is not in the Recording")
+        src = ds[name].attrs.get("units")
+        if src is None:
+            raise RecordingError(f"{name!r} has no 'units' attribute")
+        f = _units.conversion_factor(src, dst)
+        out[name] = ds[name] * f
+        out[name].attrs = {**ds[name].attrs, "units": _units.normalise_unit(dst)}
+    return out
+
+
+def provenance(ds: xr.Dataset) -> dict[str, Any]:
+    """The provenance attributes of a Recording (missing ones as None)."""
+    return {k: ds.attrs.get(k) for k in _PROVENANCE}
