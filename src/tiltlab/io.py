@@ -43,10 +43,19 @@ class ReadError(OSError):
     """A file is missing, truncated, corrupt or not in the expected layout."""
 
 
-def _read_table(path: PathLike, required: Sequence[str], **kwargs) -> pd.DataFrame:
+def _read_table(path: PathLike, required: Sequence[str], *, final_newline: bool = False, **kwargs) -> pd.DataFrame:
     path = Path(path)
     if not path.is_file():
         raise ReadError(f"{path}: no such file")
+    if final_newline:
+        # files written line by line end with a newline; a missing one means the copy was cut short
+        with open(path, "rb") as f:
+            f.seek(0, os.SEEK_END)
+            if f.tell() == 0:
+                raise ReadError(f"{path}: empty file")
+            f.seek(-1, os.SEEK_END)
+            if f.read(1) not in (b"\n", b"\r"):
+                raise ReadError(f"{path}: last line is incomplete (no final newline): truncated file?")
     try:
         df = pd.read_csv(path, **kwargs)
     except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError, ValueError) as exc:
@@ -83,7 +92,7 @@ def read_fayat_imu(path: PathLike, *, counter_rate: float = 300.0, fs: float = 1
     ----------
     .. [1] R. Fayat et al., Sensors 21(18):6318, 2021. doi:10.3390/s21186318
     """
-    df = _read_table(path, ["counter", "ax", "ay", "az", "gx", "gy", "gz"])
+    df = _read_table(path, ["counter", "ax", "ay", "az", "gx", "gy", "gz"], final_newline=True)
     counter = df["counter"].to_numpy(np.int64)
     time = (counter - counter[0]) / float(counter_rate)
     return schema.make_recording(
@@ -112,7 +121,7 @@ def read_fayat_tumble(path: PathLike, *, fs: float = 300.0, **attrs) -> xr.Datas
     300 Hz. The sensor is held still in several orientations; there is no trigger
     channel.
     """
-    df = _read_table(path, ["ax", "ay", "az", "gx", "gy", "gz", "time"], index_col=0)
+    df = _read_table(path, ["ax", "ay", "az", "gx", "gy", "gz", "time"], final_newline=True, index_col=0)
     return schema.make_recording(
         df[["ax", "ay", "az"]].to_numpy(),
         df[["gx", "gy", "gz"]].to_numpy(),
@@ -336,13 +345,16 @@ def save_netcdf(ds: xr.Dataset, path: PathLike) -> Path:
     return path
 
 
-def load_netcdf(path: PathLike, *, validate: bool = False) -> xr.Dataset:
+def load_netcdf(path: PathLike, *, validate: bool = False, **validate_kwargs) -> xr.Dataset:
     """Load a Dataset written by :func:`save_netcdf` (fully into memory).
 
     Parameters
     ----------
     validate : bool
         Also run :func:`tiltlab.schema.validate` (for Recordings).
+    **validate_kwargs
+        Passed to :func:`tiltlab.schema.validate` (``allow_nan`` defaults to whether the
+        file holds NaN).
     """
     path = Path(path)
     if not path.is_file():
@@ -363,5 +375,5 @@ def load_netcdf(path: PathLike, *, validate: bool = False) -> xr.Dataset:
         ds[name].encoding = {}
     if validate:
         allow_nan = any(bool(np.isnan(ds[v].values).any()) for v in ds.data_vars if ds[v].dtype.kind == "f")
-        schema.validate(ds, allow_nan=allow_nan)
+        schema.validate(ds, **{"allow_nan": allow_nan, **validate_kwargs})
     return ds

@@ -1,0 +1,155 @@
+"""Readers and writers: real files, generic CSV, NetCDF round trip, damaged files."""
+import shutil
+
+import numpy as np
+import pytest
+import xarray as xr
+
+from tiltlab import io, schema
+from tiltlab import quaternion as Q
+from tiltlab.io import ReadError
+
+
+@pytest.fixture(scope="module")
+def fayat_dir(data_mirror):
+    return data_mirror / "fayat2021"
+
+
+def test_read_fayat_example(fayat_dir):
+    rec = io.read_fayat_imu(fayat_dir / "example_imu.csv")
+    assert rec.sizes["time"] == 4893 and rec.attrs["fs"] == 100.0
+    assert rec.acc.attrs["units"] == "g" and rec.gyr.attrs["units"] == "deg/s"
+    # time comes from the 300 Hz counter: mostly 3-count steps, some 2-count steps
+    steps = np.round(np.diff(rec.time.values) * 300).astype(int)
+    assert set(np.unique(steps)) == {2, 3}
+    # a head IMU in g: the mean norm is close to 1 g
+    assert 0.95 < float(np.linalg.norm(rec.acc.values, axis=1).mean()) < 1.05
+
+
+def test_read_fayat_tumble(fayat_dir):
+    rec = io.read_fayat_tumble(fayat_dir / "example_sensor_calibration.csv")
+    assert rec.attrs["fs"] == 300.0 and rec.sizes["time"] == 30543
+    np.testing.assert_allclose(np.diff(rec.time.values), 1 / 300, rtol=1e-6)
+
+
+@pytest.mark.parametrize("name", ["02_undisturbed_slow_rotation_B.hdf5", "01_undisturbed_slow_rotation_A.mat"])
+def test_read_broad_both_layouts(data_mirror, name):
+    rec = io.read_broad(data_mirror / "broad" / name)
+    assert rec.attrs["fs"] == pytest.approx(285.714285714, rel=1e-9)
+    assert rec.movement.dtype == bool and 0 < rec.movement.sum() < rec.sizes["time"]
+    assert rec.acc.attrs["units"] == "m/s^2" and rec.gyr.attrs["units"] == "rad/s"
+    q = rec.q_ref.values
+    ok = np.isfinite(q).all(axis=1)
+    np.testing.assert_allclose(np.linalg.norm(q[ok], axis=1), 1.0, atol=1e-6)
+    # optical ground truth is aligned to the IMU: at rest, acc points along the tilt g_s = R(q)^T e_z
+    still = ok & (np.linalg.norm(rec.gyr.values, axis=1) < 0.02)
+    ang = Q.angle_between(rec.acc.values[still], Q.gravity(q[still]))
+    assert np.median(np.degrees(ang)) < 2.0
+
+
+def test_mat_and_hdf5_layouts_agree(tmp_path, data_mirror):
+    """Write the .mat layout from an hdf5 trial and check both readers give the same Recording."""
+    import scipy.io
+
+    rec = io.read_broad(data_mirror / "broad" / "02_undisturbed_slow_rotation_B.hdf5")
+    scipy.io.savemat(
+        tmp_path / "02.mat",
+        {
+            "imu_acc": rec.acc.values, "imu_gyr": rec.gyr.values, "imu_mag": rec.mag.values,
+            "opt_quat": rec.q_ref.values, "opt_pos": rec.opt_pos.values,
+            "movement": rec.movement.values.astype(np.uint8)[:, None],
+            "sampling_rate": np.array([[rec.attrs["fs"]]]), "info": np.array([rec.attrs["info"]]),
+        },
+    )
+    back = io.read_broad(tmp_path / "02.mat")
+    for v in ("acc", "gyr", "mag", "q_ref", "opt_pos", "movement"):
+        np.testing.assert_array_equal(back[v].values, rec[v].values)
+    assert back.attrs["info"] == rec.attrs["info"]
+
+
+def test_generic_csv(tmp_path):
+    rng = np.random.default_rng(2)
+    n, fs = 400, 50.0
+    acc = rng.normal(0, 0.01, (n, 3)) + [0, 0, 9.81]
+    gyr = rng.normal(0, 0.01, (n, 3))
+    t = 10.0 + np.arange(n) / fs
+    lines = ["T;AX;AY;AZ;GX;GY;GZ;TEMP"] + [
+        ";".join(f"{v:.17g}" for v in (t[i], *acc[i], *gyr[i], 25.0 + i * 0.001)) for i in range(n)
+    ]
+    p = tmp_path / "log.csv"
+    p.write_text("\n".join(lines))
+    rec = io.read_csv(
+        p, {"acc": ["AX", "AY", "AZ"], "gyr": ["GX", "GY", "GZ"], "temp": "TEMP"},
+        {"acc": "m/s^2", "gyr": "rad/s", "temp": "degC"}, time_column="T", sep=";",
+    )
+    assert rec.attrs["fs"] == pytest.approx(fs) and "fs_source" in rec.attrs
+    np.testing.assert_array_equal(rec.acc.values, acc)
+    np.testing.assert_array_equal(rec.time.values, t)
+    assert rec.temp.attrs["units"] == "degC"
+    with pytest.raises(ValueError, match="units must give the unit of 'gyr'"):
+        io.read_csv(p, {"acc": ["AX", "AY", "AZ"], "gyr": ["GX", "GY", "GZ"]}, {"acc": "g"}, fs=fs, sep=";")
+    with pytest.raises(ValueError, match="never assumes a sampling rate"):
+        io.read_csv(p, {"acc": ["AX", "AY", "AZ"], "gyr": ["GX", "GY", "GZ"]}, {"acc": "g", "gyr": "rad/s"}, sep=";")
+    with pytest.raises(ReadError, match="missing column"):
+        io.read_csv(p, {"acc": ["AX", "AY", "Q"], "gyr": ["GX", "GY", "GZ"]}, {"acc": "g", "gyr": "rad/s"}, fs=fs, sep=";")
+
+
+def test_truncated_and_corrupt_files(tmp_path, data_mirror):
+    src = data_mirror / "fayat2021" / "example_imu.csv"
+    text = src.read_text()
+    cut = tmp_path / "cut.csv"
+    cut.write_text(text[: len(text) // 2 - 7])  # ends mid-line
+    with pytest.raises(ReadError, match="incomplete.*truncated"):
+        io.read_fayat_imu(cut)
+    garbage = tmp_path / "garbage.csv"
+    garbage.write_text(text.replace("0.4", "zz", 1))
+    with pytest.raises(ReadError, match="non-numeric value"):
+        io.read_fayat_imu(garbage)
+    h5 = data_mirror / "broad" / "02_undisturbed_slow_rotation_B.hdf5"
+    bad_h5 = tmp_path / "bad.hdf5"
+    bad_h5.write_bytes(h5.read_bytes()[:100_000])
+    with pytest.raises(ReadError, match="truncated or corrupt"):
+        io.read_broad(bad_h5)
+    mat = data_mirror / "broad" / "01_undisturbed_slow_rotation_A.mat"
+    bad_mat = tmp_path / "bad.mat"
+    bad_mat.write_bytes(mat.read_bytes()[:100_000])
+    with pytest.raises(ReadError, match="truncated or corrupt"):
+        io.read_broad(bad_mat)
+    with pytest.raises(ReadError, match="no such file"):
+        io.read_broad(tmp_path / "nothing.hdf5")
+    other = tmp_path / "x.txt"
+    shutil.copy(src, other)
+    with pytest.raises(ReadError, match="unknown BROAD file type"):
+        io.read_broad(other)
+
+
+def test_netcdf_round_trip_is_exact(tmp_path):
+    rng = np.random.default_rng(5)
+    n = 500
+    q = Q.random_quaternions(n, rng)
+    rec = schema.make_recording(
+        Q.gravity(q), rng.normal(0, 1, (n, 3)), 200.0, q_ref=q,
+        mag=rng.normal(0, 30, (n, 3)), temp=25 + rng.normal(0, 0.1, n),
+        extra={"moving": ("time", rng.random(n) > 0.5, {"long_name": "a mask"}),
+               "state": ("time", rng.integers(0, 4, n).astype(np.int8), {"legend": {"0": "still", "1": "walk"}})},
+        attrs={"subject": "rat 7", "flag": True, "none": None, "offsets": [0.1, -0.2, 0.05],
+               "nested": {"a": 1, "b": [1, 2]}, "arr": np.arange(3.0), "n": np.int64(4)},
+        check_units=False,
+    )
+    path = io.save_netcdf(rec, tmp_path / "sub" / "r.nc")
+    back = io.load_netcdf(path, validate=True, check_units=False)  # random gyro data
+    xr.testing.assert_identical(back, rec.assign_attrs(arr=back.attrs["arr"]))
+    np.testing.assert_array_equal(back.attrs["arr"], rec.attrs["arr"])
+    assert back.attrs["flag"] is True and back.attrs["none"] is None
+    assert back.state.attrs["legend"] == {"0": "still", "1": "walk"}
+    assert back.moving.dtype == bool and back.state.dtype == np.int8
+    bad = tmp_path / "bad.nc"
+    bad.write_bytes(path.read_bytes()[:2000])
+    with pytest.raises(ReadError, match="truncated or corrupt"):
+        io.load_netcdf(bad)
+
+
+def test_netcdf_round_trip_real_trial(tmp_path, data_mirror):
+    rec = io.read_broad(data_mirror / "broad" / "02_undisturbed_slow_rotation_B.hdf5")
+    back = io.load_netcdf(io.save_netcdf(rec, tmp_path / "t.nc"), validate=True)
+    xr.testing.assert_identical(back, rec)

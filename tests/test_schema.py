@@ -1,0 +1,158 @@
+"""The Recording contract: constructor, validation errors, unit conversions."""
+import numpy as np
+import pytest
+import xarray as xr
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from tiltlab import quaternion as Q
+from tiltlab import schema, units
+from tiltlab.schema import RecordingError
+
+
+def rotating_sensor(n=2000, fs=100.0, seed=0):
+    """A sensor turning about a tilted axis: acc = specific force of gravity (g), gyr (deg/s)."""
+    rng = np.random.default_rng(seed)
+    t = np.arange(n) / fs
+    omega = np.column_stack([2.0 * np.sin(0.7 * t), 1.5 * np.cos(0.5 * t), 0.5 + 0 * t])  # rad/s
+    q = Q.integrate_gyro(omega, fs, Q.random_quaternions(1, rng)[0])
+    acc = Q.gravity(q) + rng.normal(0, 0.01, (n, 3))
+    return acc, np.degrees(omega), q, fs
+
+
+def test_make_recording_structure():
+    acc, gyr, q, fs = rotating_sensor()
+    rec = schema.make_recording(acc, gyr, fs, q_ref=q, attrs={"subject": "r1"})
+    assert rec.sizes == {"time": 2000, "axis": 3, "quat": 4}
+    assert list(rec.axis.values) == ["x", "y", "z"] and list(rec.quat.values) == ["w", "x", "y", "z"]
+    assert rec.acc.attrs["units"] == "g" and rec.gyr.attrs["units"] == "deg/s"
+    assert rec.attrs["fs"] == fs and rec.attrs["frame"] == "sensor" and rec.attrs["subject"] == "r1"
+    np.testing.assert_allclose(np.diff(rec.time.values), 1 / fs)
+    assert schema.provenance(rec)["subject"] == "r1"
+
+
+def test_inputs_are_not_mutated_or_aliased():
+    acc, gyr, q, fs = rotating_sensor(200)
+    acc0 = acc.copy()
+    rec = schema.make_recording(acc, gyr, fs)
+    rec["acc"][:] = 0
+    np.testing.assert_array_equal(acc, acc0)
+
+
+@pytest.mark.parametrize(
+    "mutate, message",
+    [
+        (lambda r: r.attrs.pop("fs"), "'fs'.*missing"),
+        (lambda r: r.attrs.__setitem__("fs", -5), "positive"),
+        (lambda r: r.attrs.__setitem__("fs", "fast"), "number of Hz"),
+        (lambda r: r.attrs.pop("frame"), "'frame'"),
+        (lambda r: r["gyr"].attrs.__setitem__("units", "furlong/fortnight"), "unknown unit"),
+        (lambda r: r["gyr"].attrs.__setitem__("units", "g"), "do not measure angular velocity"),
+        (lambda r: r["acc"].attrs.pop("units"), "no 'units'"),
+    ],
+)
+def test_validate_rejects_bad_metadata(mutate, message):
+    acc, gyr, q, fs = rotating_sensor(300)
+    rec = schema.make_recording(acc, gyr, fs, q_ref=q)
+    mutate(rec)
+    with pytest.raises(RecordingError, match=message):
+        schema.validate(rec)
+
+
+def test_validate_rejects_bad_data():
+    acc, gyr, q, fs = rotating_sensor(300)
+    with pytest.raises(RecordingError, match="mandatory"):
+        schema.make_recording(acc, gyr, None)
+    with pytest.raises(RecordingError, match=r"shape \(N, 3\)"):
+        schema.make_recording(acc[:, :2], gyr, fs)
+    with pytest.raises(RecordingError, match="lengths differ: 300 vs 299"):
+        schema.make_recording(acc, gyr[:-1], fs)
+    bad = acc.copy()
+    bad[17, 1] = np.nan
+    with pytest.raises(RecordingError, match=r"'acc' has 1 non-finite.*\(17, 1\)"):
+        schema.make_recording(bad, gyr, fs)
+    schema.make_recording(bad, gyr, fs, allow_nan=True)  # gaps accepted on request
+    bad[17, 1] = np.inf
+    with pytest.raises(RecordingError, match="non-finite"):
+        schema.make_recording(bad, gyr, fs, allow_nan=True)
+    qb = q.copy()
+    qb[5] *= 1.01
+    with pytest.raises(RecordingError, match="non-unit quaternions.*sample 5"):
+        schema.make_recording(acc, gyr, fs, q_ref=qb)
+
+
+def test_validate_rejects_bad_time():
+    acc, gyr, q, fs = rotating_sensor(300)
+    t = np.arange(300) / fs
+    t_back = t.copy()
+    t_back[100] = t_back[99]
+    with pytest.raises(RecordingError, match="not strictly increasing"):
+        schema.make_recording(acc, gyr, fs, time=t_back)
+    t_gap = np.concatenate([t[:150], t[150:] + 1 / fs])  # one dropped sample
+    with pytest.raises(RecordingError, match="irregular.*interval 149"):
+        schema.make_recording(acc, gyr, fs, time=t_gap)
+    with pytest.raises(RecordingError, match="irregular"):
+        schema.make_recording(acc, gyr, fs * 2, time=t)  # wrong fs
+    small_jitter = t + np.random.default_rng(0).uniform(-0.1, 0.1, 300) / fs
+    schema.make_recording(acc, gyr, fs, time=small_jitter)
+
+
+def test_validate_rejects_wrong_dims():
+    acc, gyr, q, fs = rotating_sensor(100)
+    rec = schema.make_recording(acc, gyr, fs)
+    bad = rec.assign(gyr=rec.gyr.transpose("axis", "time"))
+    with pytest.raises(RecordingError, match="dims \\('time', 'axis'\\)"):
+        schema.validate(bad)
+    with pytest.raises(RecordingError, match="xarray.Dataset"):
+        schema.validate(rec.acc)
+
+
+def test_gyro_in_rad_s_labelled_deg_s_is_caught():
+    acc, gyr_deg, q, fs = rotating_sensor()
+    gyr_rad = np.radians(gyr_deg)
+    schema.make_recording(acc, gyr_rad, fs, gyr_units="rad/s")
+    with pytest.raises(RecordingError, match="look like rad/s labelled deg/s"):
+        schema.make_recording(acc, gyr_rad, fs, gyr_units="deg/s")
+    with pytest.raises(RecordingError, match="look like deg/s labelled rad/s"):
+        schema.make_recording(acc, gyr_deg, fs, gyr_units="rad/s")
+    # the check can be switched off explicitly
+    schema.make_recording(acc, gyr_rad, fs, gyr_units="deg/s", check_units=False)
+
+
+def test_static_recording_passes_unit_check():
+    rng = np.random.default_rng(1)
+    acc = np.array([0, 0, 1.0]) + rng.normal(0, 0.003, (500, 3))
+    gyr = rng.normal(0, 0.05, (500, 3)) + [1.0, -2.0, 0.5]
+    assert units.check_gyro_units(gyr, "deg/s", acc, 100.0) is None
+    schema.make_recording(acc, gyr, 100.0)
+
+
+@given(st.floats(-1e3, 1e3, allow_nan=False), st.sampled_from([("g", "m/s^2"), ("deg/s", "rad/s"), ("uT", "nT"), ("gauss", "uT")]))
+@settings(max_examples=100, deadline=None)
+def test_unit_conversions_round_trip(x, pair):
+    a, b = pair
+    y = units.convert(x, a, b)
+    np.testing.assert_allclose(units.convert(y, b, a), x, rtol=1e-14, atol=1e-300)
+
+
+def test_unit_factors_and_errors():
+    assert units.conversion_factor("g", "m/s^2") == units.G0
+    np.testing.assert_allclose(units.convert(180.0, "°/s", "rad/s"), np.pi)
+    assert units.normalise_unit("µT") == "uT"
+    with pytest.raises(units.UnitsError, match="cannot convert"):
+        units.convert(1.0, "g", "rad/s")
+    with pytest.raises(units.UnitsError, match="unknown unit"):
+        units.normalise_unit("parsec")
+
+
+def test_to_units_converts_and_keeps_attrs():
+    acc, gyr, q, fs = rotating_sensor(200)
+    rec = schema.make_recording(acc, gyr, fs, attrs={"subject": "a"})
+    si = schema.to_units(rec, acc="m/s^2", gyr="rad/s")
+    np.testing.assert_allclose(si.acc.values, acc * units.G0)
+    np.testing.assert_allclose(si.gyr.values, np.radians(gyr))
+    assert si.acc.attrs["units"] == "m/s^2" and si.gyr.attrs["units"] == "rad/s"
+    assert si.attrs == rec.attrs
+    assert rec.acc.attrs["units"] == "g"  # input untouched
+    schema.validate(si)
+    xr.testing.assert_allclose(schema.to_units(si, acc="g", gyr="deg/s"), rec)
