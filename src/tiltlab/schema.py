@@ -341,3 +341,29 @@ def to_units(ds: xr.Dataset, **targets: str) -> xr.Dataset:
 def provenance(ds: xr.Dataset) -> dict[str, Any]:
     """The provenance attributes of a Recording (missing ones as None)."""
     return {k: ds.attrs.get(k) for k in _PROVENANCE}
+
+
+def describe(ds: xr.Dataset) -> dict[str, Any]:
+    """A one-line summary of a Recording: samples, duration, rate, variables with units, gaps.
+
+    Returns
+    -------
+    dict
+        Keys ``session, samples, duration_s, fs_hz, variables, missing_q_ref`` (fraction of
+        samples whose reference orientation is NaN, or None without ``q_ref``).
+    """
+    t = ds["time"].values
+    variables = ", ".join(
+        f"{v} [{ds[v].attrs['units']}]" if "units" in ds[v].attrs else str(v) for v in ds.data_vars
+    )
+    missing = None
+    if "q_ref" in ds:
+        missing = float(np.mean(~np.isfinite(ds["q_ref"].values).all(axis=1)))
+    return {
+        "session": ds.attrs.get("session"),
+        "samples": int(ds.sizes["time"]),
+        "duration_s": float(t[-1] - t[0] + 1.0 / float(ds.attrs["fs"])) if t.size else 0.0,
+        "fs_hz": float(ds.attrs["fs"]),
+        "variables": variables,
+        "missing_q_ref": missing,
+    }
