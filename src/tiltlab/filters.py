@@ -500,8 +500,8 @@ def _complementary_kernel(acc, gyr, mag, use_mag, dt, k_acc, k_mag, q0, out):
                 ux, uy = sh * gy / s, -sh * gx / s
                 # Δq = (ch, ux, uy, 0); q ← Δq ⊗ q
                 nw = ch * w - ux * x - uy * y
-                nx = ch * x + ux * w - uy * z
-                ny = ch * y + uy * w + ux * z
+                nx = ch * x + ux * w + uy * z
+                ny = ch * y + uy * w - ux * z
                 nz = ch * z + ux * y - uy * x
                 w, x, y, z = nw, nx, ny, nz
         if use_mag and k_mag > 0.0:
@@ -572,10 +572,11 @@ def _q0(q0, acc, mag, fs, init_window) -> np.ndarray:
     return q0 / np.linalg.norm(q0)
 
 
-def _positive(value, name: str, allow_zero: bool = False) -> float:
+def _positive(value, name: str, allow_zero: bool = False, allow_inf: bool = False) -> float:
     v = float(value)
-    if not np.isfinite(v) or v < 0 or (v == 0 and not allow_zero):
-        raise ValueError(f"{name} must be {'non-negative' if allow_zero else 'positive'} and finite, got {value!r}")
+    if np.isnan(v) or v < 0 or (v == 0 and not allow_zero) or (np.isinf(v) and not allow_inf):
+        kind = "non-negative" if allow_zero else "positive"
+        raise ValueError(f"{name} must be {kind}{'' if allow_inf else ' and finite'}, got {value!r}")
     return v
 
 
@@ -703,8 +704,8 @@ def complementary(acc, gyr, fs: float, *, mag=None, tau_acc: float = 1.0, tau_ma
     fs = _check_fs(fs)
     acc, gyr, m, use_mag = _inputs(acc, gyr, mag)
     dt = 1.0 / fs
-    k_acc = -np.expm1(-dt / _positive(tau_acc, "tau_acc"))
-    k_mag = -np.expm1(-dt / _positive(tau_mag, "tau_mag"))
+    k_acc = -np.expm1(-dt / _positive(tau_acc, "tau_acc", allow_inf=True))
+    k_mag = -np.expm1(-dt / _positive(tau_mag, "tau_mag", allow_inf=True))
     q0 = _q0(q0, acc, mag if use_mag else None, fs, init_window)
     out = np.empty((acc.shape[0], 4))
     _complementary_kernel(acc, gyr, m, use_mag, dt, k_acc, k_mag, q0, out)
@@ -876,9 +877,9 @@ def ekf(acc, gyr, fs: float, *, mag=None, var_gyr: float = 0.3**2, var_acc: floa
 
 def smoother(acc, gyr, fs: float, **params) -> np.ndarray:
     """Offline forward–backward smoother (see :mod:`tiltlab.filters` notes)."""
-    from ._smoother import smoother as _sm  # noqa: F401  (placeholder until implemented)
+    raise NotImplementedError
 
-    return _sm(acc, gyr, fs, **params)
+
 
 
 # ====================================================================== recordings

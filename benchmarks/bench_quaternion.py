@@ -1,0 +1,52 @@
+"""Throughput of tiltlab's quaternion kernels against scipy's Rotation, measured in the same run.
+
+Run: python benchmarks/bench_quaternion.py [N]
+"""
+import sys
+import time
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from tiltlab import quaternion as Q
+
+
+def best_of(fn, repeat=5):
+    fn()  # warm-up (numba compilation, caches)
+    times = []
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        fn()
+        times.append(time.perf_counter() - t0)
+    return min(times)
+
+
+def main(n: int = 1_000_000) -> None:
+    rng = np.random.default_rng(0)
+    q = Q.random_quaternions(n, rng)
+    p = Q.random_quaternions(n, rng)
+    v = rng.normal(size=(n, 3))
+    rq, rp = Q.to_scipy(q), Q.to_scipy(p)
+    omega = rng.normal(size=(n, 3))
+    cases = [
+        ("mul", lambda: Q.mul(p, q), lambda: rp * rq),
+        ("rotate", lambda: Q.rotate(q, v), lambda: rq.apply(v)),
+        ("gravity", lambda: Q.gravity(q), lambda: rq.inv().apply([0.0, 0.0, 1.0])),
+        ("to_matrix", lambda: Q.to_matrix(q), lambda: rq.as_matrix()),
+        ("from_matrix", lambda m=Q.to_matrix(q): Q.from_matrix(m), lambda m=rq.as_matrix(): Rotation.from_matrix(m)),
+        ("to_rotvec", lambda: Q.to_rotvec(q), lambda: rq.as_rotvec()),
+        ("tilt_error", lambda: Q.tilt_error(p, q), None),
+        ("integrate_gyro", lambda: Q.integrate_gyro(omega, 100.0), None),
+    ]
+    print(f"{'operation':>15} {'tiltlab Msamples/s':>20} {'scipy Msamples/s':>18} {'ratio':>7}   (N = {n:,})")
+    for name, ours, ref in cases:
+        t = best_of(ours)
+        line = f"{name:>15} {n / t / 1e6:20.1f}"
+        if ref is not None:
+            tr = best_of(ref)
+            line += f" {n / tr / 1e6:18.1f} {tr / t:7.1f}"
+        print(line)
+
+
+if __name__ == "__main__":
+    main(int(sys.argv[1]) if len(sys.argv) > 1 else 1_000_000)

@@ -1,0 +1,2 @@
+"""Simulated recordings with ground truth (placeholder, filled below)."""
+from .kinematics import *  # noqa
