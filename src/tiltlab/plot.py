@@ -64,7 +64,7 @@ def plot_recording(
         plot_vectors(ax, t, da.values, labels=comp, ylabel=f"{v} [{da.attrs.get('units', '')}]")
         if shade is not None:
             shade_mask(ax, t, sel[shade].values, label=shade)
-        ax.legend(loc="upper right", ncol=len(comp) + 1, fontsize=8, frameon=False)
+        ax.legend(loc="upper left", bbox_to_anchor=(1.005, 1.0), fontsize=8, frameon=False)
     axes[-1, 0].set_xlabel("time [s]")
     if title:
         axes[0, 0].set_title(title)

@@ -1,2 +1,3 @@
 """Simulated recordings with ground truth (placeholder, filled below)."""
 from .kinematics import *  # noqa
+from .sensor import *  # noqa
