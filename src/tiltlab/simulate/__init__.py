@@ -1,3 +1,0 @@
-"""Simulated recordings with ground truth (placeholder, filled below)."""
-from .kinematics import *  # noqa
-from .sensor import *  # noqa
