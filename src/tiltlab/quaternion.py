@@ -49,6 +49,7 @@ __all__ = [
     "gravity",
     "angle_between",
     "error_quaternion",
+    "error_angles",
     "tilt_error",
     "heading_error",
     "total_error",
@@ -417,7 +418,11 @@ def error_quaternion(q_est, q_ref) -> np.ndarray:
     return mul(q_est, conj(q_ref))
 
 
-def _error_angles(q_est, q_ref) -> np.ndarray:
+def error_angles(q_est, q_ref) -> np.ndarray:
+    r"""Total, heading and tilt errors (rad) in one pass, stacked on the last axis (..., 3).
+
+    See :func:`total_error`, :func:`heading_error` and :func:`tilt_error`.
+    """
     p, q = np.asarray(q_est, float), np.asarray(q_ref, float)
     _check_last(p, 4, "q_est")
     _check_last(q, 4, "q_ref")
@@ -429,13 +434,13 @@ def _error_angles(q_est, q_ref) -> np.ndarray:
 
 def total_error(q_est, q_ref) -> np.ndarray:
     r"""Total orientation error (rad): the angle of :math:`e = q_{est} \otimes q_{ref}^{-1}`, in [0, π]."""
-    return _error_angles(q_est, q_ref)[..., 0]
+    return error_angles(q_est, q_ref)[..., 0]
 
 
 def heading_error(q_est, q_ref) -> np.ndarray:
     r"""Heading error (rad): the angle of the rotation about world z in the heading–inclination
     decomposition of the Earth-frame error, :math:`2\,\mathrm{atan2}(|e_z|, |e_w|)`, in [0, π]."""
-    return _error_angles(q_est, q_ref)[..., 1]
+    return error_angles(q_est, q_ref)[..., 1]
 
 
 def tilt_error(q_est, q_ref) -> np.ndarray:
@@ -446,7 +451,7 @@ def tilt_error(q_est, q_ref) -> np.ndarray:
     error [3]_. Computed as :math:`2\,\mathrm{atan2}(\sqrt{e_x^2+e_y^2}, \sqrt{e_w^2+e_z^2})`
     for accuracy near zero.
     """
-    return _error_angles(q_est, q_ref)[..., 2]
+    return error_angles(q_est, q_ref)[..., 2]
 
 
 def integrate_gyro(omega, fs: float, q0=None) -> np.ndarray:
