@@ -6,6 +6,7 @@ from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
 from tiltlab import behavior as B
+from tiltlab.intervals import intervals_to_mask, mask_to_intervals
 from tiltlab import quaternion as Q
 from tiltlab import schema
 
@@ -13,8 +14,8 @@ from tiltlab import schema
 @given(arrays(np.bool_, st.integers(0, 300)))
 @settings(max_examples=200, deadline=None)
 def test_interval_round_trip(mask):
-    iv = B.mask_to_intervals(mask)
-    np.testing.assert_array_equal(B.intervals_to_mask(iv, mask.size), mask)
+    iv = mask_to_intervals(mask)
+    np.testing.assert_array_equal(intervals_to_mask(iv, mask.size), mask)
     assert np.all(iv[:, 1] > iv[:, 0])
     assert np.all(iv[1:, 0] > iv[:-1, 1])  # runs are separated by at least one False
 
@@ -30,11 +31,11 @@ def test_fayat_rules_merge_and_minimum_duration():
     # then 1 s moving, 0.3 s still (dropped: < 0.5 s), 1 s moving, 0.6 s still (kept)
     s = _speed([(1.0, 2), (0.05, 50), (0.3, 3), (1.0, 80), (0.3, 5), (1.0, 90), (0.6, 1)], fs)
     m = B.detect_immobility(s, fs)
-    iv = B.mask_to_intervals(m)
+    iv = mask_to_intervals(m)
     np.testing.assert_array_equal(iv, [[0, 135], [365, 425]])
     # a 0.1 s gap is not merged (strictly less than 0.1 s merges)
     s2 = _speed([(1.0, 2), (0.1, 50), (1.0, 2)], fs)
-    assert len(B.mask_to_intervals(B.detect_immobility(s2, fs))) == 2
+    assert len(mask_to_intervals(B.detect_immobility(s2, fs))) == 2
     # threshold is strict: exactly 12 deg/s is movement
     assert not B.detect_immobility(np.full(200, 12.0), fs).any()
     assert B.detect_immobility(np.full(200, 11.999), fs).all()
@@ -44,12 +45,12 @@ def test_fayat_rules_merge_and_minimum_duration():
 @settings(max_examples=100, deadline=None)
 def test_immobility_invariants(speed, fs):
     m = B.detect_immobility(speed, fs)
-    iv = B.mask_to_intervals(m)
+    iv = mask_to_intervals(m)
     # every kept period is long enough, and every sample below threshold outside kept periods
     # belongs to a short period
     assert np.all(iv[:, 1] - iv[:, 0] >= 0.5 * fs)
     # merging only adds samples next to still periods: a still sample is either kept or in a short run
-    raw = B.mask_to_intervals(speed < 12.0)
+    raw = mask_to_intervals(speed < 12.0)
     for a, b in raw:
         if b - a >= 0.5 * fs:
             assert m[a:b].all()
@@ -110,3 +111,31 @@ def test_real_rat_example(data_mirror):
     auto = B.immobility(rat, threshold="auto")
     assert 0.0 < float(fixed.mean()) < 1.0
     assert 3.0 < auto.attrs["threshold_deg_s"] < 40.0
+
+
+def test_speed_modes_find_a_planted_mixture():
+    rng = np.random.default_rng(0)
+    s = np.r_[10 ** rng.normal(np.log10(3.0), 0.15, 30000), 10 ** rng.normal(np.log10(100.0), 0.2, 60000)]
+    m = B.speed_modes(s)
+    assert m["still_mode"] == pytest.approx(3.0, rel=0.15)
+    assert m["moving_mode"] == pytest.approx(100.0, rel=0.15)
+    assert 6.0 < m["valley"] < 40.0 and m["depth"] < 0.05
+    assert np.isnan(B.speed_modes(10 ** rng.normal(1.0, 0.2, 10000))["valley"])
+    assert B.valley_threshold(s) == m["valley"]
+
+
+def test_recording_speed_offsets():
+    from tiltlab.simulate import simulate_session
+
+    rec = simulate_session(20.0, 100.0, seed=4, keep_true=True)
+    raw = B.recording_speed(rec, offset=None)
+    np.testing.assert_allclose(raw, np.linalg.norm(rec["gyr"].values, axis=1))
+    true = np.linalg.norm(rec["gyr_true"].values, axis=1)
+    auto = B.recording_speed(rec)  # uses the simulation's true mean offset
+    assert np.median(np.abs(auto - true)) < 1.0 < np.median(np.abs(raw - true))
+    # without the truth, the quietest-window estimate still removes most of the offset
+    blind = rec.copy()
+    blind.attrs = {k: v for k, v in rec.attrs.items() if k != "true_gyr_offset_mean"}
+    assert np.median(np.abs(B.recording_speed(blind) - true)) < np.median(np.abs(raw - true))
+    with pytest.raises(ValueError, match="'auto'"):
+        B.recording_speed(rec, offset="median")

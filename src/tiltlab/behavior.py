@@ -25,13 +25,16 @@ import xarray as xr
 from scipy import ndimage, signal
 
 from . import units as _units
+from .intervals import intervals_to_mask, mask_to_intervals, samples_below
 
 __all__ = [
     "angular_speed",
-    "mask_to_intervals",
-    "intervals_to_mask",
     "detect_immobility",
+    "speed_modes",
     "valley_threshold",
+    "recording_speed",
+    "gyro_spectrum",
+    "realism_table",
     "immobility",
     "azimuthal_speed",
     "circling_index",
@@ -52,24 +55,6 @@ def angular_speed(gyr, units: str = "deg/s") -> np.ndarray:
     if g.ndim != 2 or g.shape[1] != 3:
         raise ValueError(f"gyr must have shape (N, 3), got {g.shape}")
     return np.linalg.norm(g, axis=1) * _units.conversion_factor(units, "deg/s")
-
-
-def mask_to_intervals(mask) -> np.ndarray:
-    """Runs of True in a boolean mask as an (k, 2) integer array of half-open ``[start, stop)`` indices."""
-    m = np.asarray(mask, dtype=bool)
-    if m.ndim != 1:
-        raise ValueError("mask must be one-dimensional")
-    d = np.diff(np.concatenate([[0], m.view(np.int8), [0]]))
-    return np.column_stack([np.flatnonzero(d == 1), np.flatnonzero(d == -1)]).astype(np.int64)
-
-
-def intervals_to_mask(intervals, n: int) -> np.ndarray:
-    """Boolean mask of length ``n`` that is True inside the half-open ``[start, stop)`` intervals."""
-    iv = np.asarray(intervals, dtype=np.int64).reshape(-1, 2)
-    d = np.zeros(n + 1, dtype=np.int64)
-    np.add.at(d, np.clip(iv[:, 0], 0, n), 1)
-    np.add.at(d, np.clip(iv[:, 1], 0, n), -1)
-    return np.cumsum(d[:-1]) > 0
 
 
 def detect_immobility(
@@ -107,68 +92,93 @@ def detect_immobility(
         raise ValueError("speed must be one-dimensional")
     if np.isnan(s).any():
         raise ValueError("speed has NaN values; fill or drop gaps first")
-    iv = mask_to_intervals(s < threshold)
-    if len(iv) == 0:
-        return np.zeros(s.size, dtype=bool)
-    # merge: a gap between consecutive still periods shorter than merge_gap_s is filled
-    gaps = iv[1:, 0] - iv[:-1, 1]
-    keep_break = gaps >= merge_gap_s * fs
-    starts = np.concatenate([[iv[0, 0]], iv[1:, 0][keep_break]])
-    stops = np.concatenate([iv[:-1, 1][keep_break], [iv[-1, 1]]])
-    long_enough = (stops - starts) >= min_duration_s * fs
-    return intervals_to_mask(np.column_stack([starts, stops])[long_enough], s.size)
+    iv = mask_to_intervals(
+        s < threshold,
+        merge_gap=samples_below(merge_gap_s, fs),  # gaps strictly shorter than merge_gap_s
+        min_length=int(np.ceil(min_duration_s * fs)),
+    )
+    return intervals_to_mask(iv, s.size)
 
 
-def valley_threshold(
+def speed_modes(
     speed,
     *,
     log_range: tuple[float, float] = (-1.0, 3.5),
     bins: int = 120,
     smooth_bins: float = 2.0,
-    min_prominence: float = 0.1,
-) -> float:
-    """Angular-speed threshold at the valley between the still and moving modes.
+    min_prominence: float = 0.05,
+    min_separation: float = 0.5,
+) -> dict[str, float]:
+    r"""Still mode, moving mode and the valley between them in an angular-speed distribution.
 
-    The histogram of :math:`\\log_{10}` speed is smoothed with a Gaussian kernel; its two most
-    prominent peaks are taken as the still and moving modes, and the threshold is the
-    minimum of the smoothed histogram between them.
+    The histogram of :math:`\log_{10}` speed is smoothed with a Gaussian kernel; among its
+    peaks with a prominence of at least ``min_prominence`` times the highest peak, the
+    most prominent one and the most prominent one at least ``min_separation`` decades
+    away from it are the two modes; the valley is the minimum of the smoothed histogram
+    between them (Fayat et al. Fig. A3 place their 12 °/s threshold there by eye).
 
     Parameters
     ----------
     speed : array_like
-        Angular speed (°/s).
+        Angular speed (°/s); non-positive and non-finite values are ignored.
     log_range : tuple of float
-        Range of :math:`\\log_{10}` speed histogrammed.
+        Range of :math:`\log_{10}` speed histogrammed.
     bins : int
         Number of histogram bins.
     smooth_bins : float
         Standard deviation of the Gaussian smoothing, in bins.
     min_prominence : float
-        Minimum peak prominence as a fraction of the highest peak.
+        Minimum peak prominence, as a fraction of the highest peak.
+    min_separation : float
+        Minimum distance between the two modes, in decades.
 
     Returns
     -------
-    float
-        Threshold in °/s.
+    dict
+        ``still_mode``, ``valley``, ``moving_mode`` (°/s) and ``depth`` (smoothed height of
+        the valley over that of the lower mode); all NaN when the distribution has no
+        second mode.
+    """
+    s = np.asarray(speed, dtype=float)
+    s = s[np.isfinite(s) & (s > 0)]
+    nan = {"still_mode": np.nan, "valley": np.nan, "moving_mode": np.nan, "depth": np.nan}
+    if s.size < 100:
+        return nan
+    h, edges = np.histogram(np.log10(s), bins=bins, range=log_range)
+    hs = ndimage.gaussian_filter1d(h.astype(float), smooth_bins, mode="constant")
+    centres = 0.5 * (edges[:-1] + edges[1:])
+    peaks, props = signal.find_peaks(hs, prominence=min_prominence * hs.max())
+    if len(peaks) < 2:
+        return nan
+    order = peaks[np.argsort(props["prominences"])[::-1]]
+    first = order[0]
+    second = next((p for p in order[1:] if abs(centres[p] - centres[first]) >= min_separation), None)
+    if second is None:
+        return nan
+    lo, hi = sorted((int(first), int(second)))
+    valley = lo + int(np.argmin(hs[lo : hi + 1]))
+    return {
+        "still_mode": float(10.0 ** centres[lo]),
+        "valley": float(10.0 ** centres[valley]),
+        "moving_mode": float(10.0 ** centres[hi]),
+        "depth": float(hs[valley] / min(hs[lo], hs[hi])),
+    }
+
+
+def valley_threshold(speed, **kwargs) -> float:
+    """Angular-speed threshold (°/s) at the valley between the still and moving modes.
+
+    See :func:`speed_modes` for the method and keyword arguments.
 
     Raises
     ------
     ValueError
         If the distribution does not have two modes.
     """
-    s = np.asarray(speed, dtype=float)
-    s = s[np.isfinite(s) & (s > 0)]
-    if s.size < 100:
-        raise ValueError("need at least 100 positive speed samples to find a valley")
-    h, edges = np.histogram(np.log10(s), bins=bins, range=log_range)
-    hs = ndimage.gaussian_filter1d(h.astype(float), smooth_bins, mode="constant")
-    peaks, props = signal.find_peaks(hs, prominence=min_prominence * hs.max())
-    if len(peaks) < 2:
+    m = speed_modes(speed, **kwargs)
+    if not np.isfinite(m["valley"]):
         raise ValueError("the angular-speed distribution is not bimodal: no valley to put a threshold in")
-    top2 = np.sort(peaks[np.argsort(props["prominences"])[-2:]])
-    valley = top2[0] + int(np.argmin(hs[top2[0] : top2[1] + 1]))
-    centres = 0.5 * (edges[:-1] + edges[1:])
-    return float(10.0 ** centres[valley])
+    return m["valley"]
 
 
 def immobility(
@@ -262,3 +272,102 @@ def circling_index(gyr_deg_s, g, moving=None) -> float:
             raise ValueError("no movement samples to average over")
         az = az[m]
     return float(np.mean(az) * 60.0 / 360.0)
+
+
+def recording_speed(rec: xr.Dataset, *, offset="auto") -> np.ndarray:
+    """Angular speed (°/s) of a Recording, gyroscope offset removed.
+
+    Parameters
+    ----------
+    rec : xarray.Dataset
+        Recording with ``gyr`` and ``fs``.
+    offset : "auto", None or array_like (3,)
+        ``"auto"``: the true mean offset of a simulated recording (attribute
+        ``true_gyr_offset_mean``, °/s) if present, else a first-pass estimate from the
+        quietest windows (:func:`tiltlab.calibration.robust_gyro_offset`); ``None``: no
+        correction; or the offset in the units of ``rec.gyr``.
+    """
+    from .calibration import robust_gyro_offset
+
+    units = rec["gyr"].attrs["units"]
+    gyr = np.asarray(rec["gyr"].values, dtype=float)
+    if isinstance(offset, str):
+        if offset != "auto":
+            raise ValueError(f"offset must be 'auto', None or 3 numbers, got {offset!r}")
+        if "true_gyr_offset_mean" in rec.attrs:
+            off = np.asarray(rec.attrs["true_gyr_offset_mean"], float) * _units.conversion_factor("deg/s", units)
+        else:
+            off = robust_gyro_offset(gyr, float(rec.attrs["fs"]))
+    elif offset is None:
+        off = np.zeros(3)
+    else:
+        off = np.asarray(offset, float).reshape(3)
+    return angular_speed(gyr - off, units)
+
+
+def gyro_spectrum(rec: xr.Dataset, *, nperseg_s: float = 5.12) -> tuple[np.ndarray, np.ndarray]:
+    """Welch power spectral density of the gyroscope, summed over axes ((°/s)²/Hz).
+
+    Returns
+    -------
+    f : numpy.ndarray
+        Frequencies (Hz).
+    psd : numpy.ndarray
+        Power spectral density.
+    """
+    fs = float(rec.attrs["fs"])
+    gyr = np.asarray(rec["gyr"].values, float) * _units.conversion_factor(rec["gyr"].attrs["units"], "deg/s")
+    nper = min(gyr.shape[0], int(round(nperseg_s * fs)))
+    f, p = signal.welch(gyr - gyr.mean(axis=0), fs=fs, nperseg=nper, axis=0)
+    return f, p.sum(axis=1)
+
+
+def realism_table(recs, *, threshold_dps: float = 12.0):
+    """Side-by-side activity statistics of several recordings (one column each).
+
+    Rows: duration; still mode, valley, moving mode and valley depth of the angular-speed
+    distribution (:func:`speed_modes` on :func:`recording_speed`); fraction of samples
+    below ``threshold_dps``; percentiles of ‖acc‖ (g), overall and while moving; the
+    largest peak of the gyroscope spectrum above 0.5 Hz, its median frequency (half the
+    power above 0.5 Hz lies below it) and the share of power above 10 Hz.
+
+    Parameters
+    ----------
+    recs : mapping of str to xarray.Dataset
+        Recordings by column name.
+    threshold_dps : float
+        Angular-speed threshold (°/s) separating still and moving samples.
+
+    Returns
+    -------
+    pandas.DataFrame
+    """
+    import pandas as pd
+
+    cols = {}
+    for name, rec in recs.items():
+        sp = recording_speed(rec)
+        m = speed_modes(sp)
+        acc = np.asarray(rec["acc"].values, float) * _units.conversion_factor(rec["acc"].attrs["units"], "g")
+        an = np.linalg.norm(acc, axis=1)
+        mov = sp >= threshold_dps
+        f, p = gyro_spectrum(rec)
+        band = f > 0.5
+        cum = np.cumsum(p[band])
+        cols[name] = {
+            "duration (s)": rec.sizes["time"] / float(rec.attrs["fs"]),
+            "still mode (deg/s)": m["still_mode"],
+            "valley (deg/s)": m["valley"],
+            "moving mode (deg/s)": m["moving_mode"],
+            "valley depth (rel. to lower mode)": m["depth"],
+            f"fraction < {threshold_dps:g} deg/s": float(np.mean(~mov)),
+            "|acc| p5 (g)": np.percentile(an, 5),
+            "|acc| p50 (g)": np.percentile(an, 50),
+            "|acc| p95 (g)": np.percentile(an, 95),
+            "|acc| p5 moving (g)": np.percentile(an[mov], 5) if mov.any() else np.nan,
+            "|acc| p95 moving (g)": np.percentile(an[mov], 95) if mov.any() else np.nan,
+            "gyro spectral peak (Hz)": f[band][np.argmax(p[band])],
+            "gyro median frequency (Hz)": f[band][np.searchsorted(cum, cum[-1] / 2)],
+            "gyro power share > 10 Hz": float(p[f > 10].sum() / p.sum()),
+        }
+    return pd.DataFrame(cols)

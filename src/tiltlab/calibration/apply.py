@@ -1,0 +1,274 @@
+r"""The :class:`Calibration` record and :func:`calibrate`, which applies it to a Recording.
+
+A calibration maps raw readings to corrected ones, per sensor,
+
+.. math:: x' = R\,C\,\big(x - o(T)\big),
+
+with offsets :math:`o` (constant, or a :class:`TemperatureModel` of the sensor
+temperature T), a scale/misalignment correction matrix :math:`C` (identity if absent)
+and an optional frame rotation :math:`R` (e.g. IMU→head from :func:`imu_to_head_alignment`
+or device→body from :func:`mounting_rotation`). Offsets are stored in g, °/s and µT;
+:func:`calibrate` converts to the Recording's units. What was applied is recorded, as
+JSON, in ``attrs["calibration"]``; applying the same calibration twice, or correcting an
+already corrected quantity again, raises :class:`CalibrationError`.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+from dataclasses import dataclass, field, fields
+from typing import Any, NamedTuple
+
+import numpy as np
+import xarray as xr
+
+from .. import quaternion as _quat
+from .. import units as _units
+from ._util import CalibrationError, mat3
+from .accel import EllipsoidFit, OffsetFit, fit_ellipsoid, fit_offsets
+from .static import StaticStats, detect_static, gyro_offset, static_means
+from .temperature import TemperatureModel
+
+__all__ = ["Calibration", "calibrate", "applied_calibrations", "TumbleResult", "tumble_calibration"]
+
+_UNITS = {"acc": "g", "gyr": "deg/s", "mag": "uT"}
+
+
+def _tup(v, shape):
+    if v is None:
+        return None
+    a = np.asarray(v, dtype=float)
+    if a.shape != shape or not np.all(np.isfinite(a)):
+        raise ValueError(f"expected a finite array of shape {shape}, got {a.shape}")
+    return tuple(map(tuple, a)) if a.ndim == 2 else tuple(a.tolist())
+
+
+@dataclass(frozen=True)
+class Calibration:
+    """Sensor corrections (offsets in g, °/s, µT; matrices dimensionless).
+
+    Attributes
+    ----------
+    name : str
+        Label (provenance; not part of the identity used to detect double application).
+    acc_offset, gyr_offset, mag_offset : 3 floats, optional
+    acc_matrix, gyr_matrix, mag_matrix : 3×3, optional
+        Correction matrices C (applied after offset removal).
+    acc_temp, gyr_temp : TemperatureModel, optional
+        Temperature-dependent offsets (replace the constant offset of that sensor).
+    rotation : 3×3, optional
+        Frame rotation applied last to all vectors; ``target_frame`` names the new frame.
+    info : dict
+        JSON-compatible extra information (uncertainties, fit diagnostics).
+    """
+
+    name: str = "calibration"
+    acc_offset: tuple | None = None
+    acc_matrix: tuple | None = None
+    gyr_offset: tuple | None = None
+    gyr_matrix: tuple | None = None
+    mag_offset: tuple | None = None
+    mag_matrix: tuple | None = None
+    acc_temp: TemperatureModel | None = None
+    gyr_temp: TemperatureModel | None = None
+    rotation: tuple | None = None
+    target_frame: str | None = None
+    info: dict = field(default_factory=dict)
+
+    def __post_init__(self):
+        for s in ("acc", "gyr", "mag"):
+            object.__setattr__(self, f"{s}_offset", _tup(getattr(self, f"{s}_offset"), (3,)))
+            object.__setattr__(self, f"{s}_matrix", _tup(getattr(self, f"{s}_matrix"), (3, 3)))
+        for s in ("acc", "gyr"):
+            tm = getattr(self, f"{s}_temp")
+            if tm is not None:
+                if not isinstance(tm, TemperatureModel):
+                    raise TypeError(f"{s}_temp must be a TemperatureModel")
+                if getattr(self, f"{s}_offset") is not None:
+                    raise ValueError(f"give either {s}_offset or {s}_temp (temperature-dependent offsets), not both")
+                if _units.normalise_unit(tm.units) != _UNITS[s]:
+                    raise ValueError(f"{s}_temp must be in {_UNITS[s]}, got {tm.units}")
+        object.__setattr__(self, "rotation", _tup(self.rotation, (3, 3)))
+        if self.rotation is not None:
+            R = np.asarray(self.rotation)
+            if not np.allclose(R @ R.T, np.eye(3), atol=1e-6) or np.linalg.det(R) < 0:
+                raise ValueError("rotation must be a proper rotation matrix")
+            if not self.target_frame:
+                raise ValueError("a rotation needs a target_frame name")
+        json.dumps(self.info)  # must be JSON-compatible
+
+    def corrects(self) -> list[str]:
+        """The corrections this calibration applies, e.g. ``["acc_offset", "acc_matrix"]``."""
+        out = []
+        for s in ("acc", "gyr", "mag"):
+            if getattr(self, f"{s}_offset") is not None or getattr(self, f"{s}_temp", None) is not None:
+                out.append(f"{s}_offset")
+            if getattr(self, f"{s}_matrix") is not None:
+                out.append(f"{s}_matrix")
+        if self.rotation is not None:
+            out.append("rotation")
+        return out
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-compatible dict (round trip with :meth:`from_dict`)."""
+        d: dict[str, Any] = {}
+        for f in fields(self):
+            v = getattr(self, f.name)
+            if isinstance(v, TemperatureModel):
+                v = v.to_dict()
+            elif isinstance(v, tuple):
+                v = np.asarray(v).tolist()
+            d[f.name] = v
+        return d
+
+    @classmethod
+    def from_dict(cls, d: dict[str, Any]) -> "Calibration":
+        kw = dict(d)
+        for s in ("acc_temp", "gyr_temp"):
+            if kw.get(s) is not None:
+                kw[s] = TemperatureModel.from_dict(kw[s])
+        return cls(**kw)
+
+    def to_json(self) -> str:
+        return json.dumps(self.to_dict(), sort_keys=True)
+
+    @classmethod
+    def from_json(cls, s: str) -> "Calibration":
+        return cls.from_dict(json.loads(s))
+
+    def fingerprint(self) -> str:
+        """SHA-256 (16 hex digits) of the corrections, excluding ``name`` and ``info``."""
+        d = self.to_dict()
+        d.pop("name")
+        d.pop("info")
+        return hashlib.sha256(json.dumps(d, sort_keys=True).encode()).hexdigest()[:16]
+
+
+def applied_calibrations(rec: xr.Dataset) -> list[dict]:
+    """The calibrations recorded in ``rec.attrs["calibration"]`` (oldest first)."""
+    raw = rec.attrs.get("calibration")
+    if raw is None:
+        return []
+    return json.loads(raw) if isinstance(raw, str) else list(raw)
+
+
+def _temp_celsius(rec):
+    if "temp" not in rec:
+        raise CalibrationError("this calibration has temperature-dependent offsets but the Recording has no 'temp'")
+    t = rec["temp"].values.astype(float)
+    u = _units.normalise_unit(rec["temp"].attrs.get("units", "degC"))
+    return t - 273.15 if u == "K" else t
+
+
+def calibrate(rec: xr.Dataset, calibration: Calibration, *, allow_stacking: bool = False) -> xr.Dataset:
+    """Apply a :class:`Calibration` to a Recording; returns a new Recording.
+
+    Parameters
+    ----------
+    rec : xarray.Dataset
+        A Recording (acc, gyr, optional mag, temp, q_ref). Units are respected (offsets
+        are converted to the variable's units; the units are unchanged).
+    calibration : Calibration
+    allow_stacking : bool
+        Allow a *different* calibration to correct a quantity that an earlier one already
+        corrected (e.g. a residual offset). The same calibration twice always raises.
+
+    Returns
+    -------
+    xarray.Dataset
+        Corrected copy; ``attrs["calibration"]`` (JSON list) gains an entry with the
+        calibration, its fingerprint and what was applied; ``attrs["frame"]`` changes if
+        a rotation was applied, and ``q_ref`` is re-expressed for the new frame.
+    """
+    if not isinstance(calibration, Calibration):
+        raise TypeError("calibration must be a tiltlab.calibration.Calibration")
+    history = applied_calibrations(rec)
+    fp = calibration.fingerprint()
+    if any(h.get("fingerprint") == fp for h in history):
+        raise CalibrationError(f"calibration {calibration.name!r} (fingerprint {fp}) was already applied to this Recording")
+    done = {c for h in history for c in h.get("applied", [])}
+    todo = [c for c in calibration.corrects() if c.split("_")[0] in rec or c == "rotation"]
+    twice = sorted(done.intersection(todo))
+    if twice and not allow_stacking:
+        raise CalibrationError(f"{', '.join(twice)} already corrected by an earlier calibration "
+                               "(pass allow_stacking=True to stack a residual correction)")
+    out = rec.copy(deep=True)
+    R = None if calibration.rotation is None else np.asarray(calibration.rotation)
+    applied = []
+    for s in ("acc", "gyr", "mag"):
+        if s not in rec:
+            continue
+        x = rec[s].values.astype(float)
+        units = rec[s].attrs.get("units", _UNITS[s])
+        f = _units.conversion_factor(_UNITS[s], units)  # calibration units -> data units
+        tm = getattr(calibration, f"{s}_temp", None)
+        o = getattr(calibration, f"{s}_offset")
+        C = getattr(calibration, f"{s}_matrix")
+        if tm is not None:
+            x = x - tm(_temp_celsius(rec)) * f
+            applied.append(f"{s}_offset")
+        elif o is not None:
+            x = x - np.asarray(o) * f
+            applied.append(f"{s}_offset")
+        if C is not None:
+            x = x @ mat3(C, f"{s}_matrix").T
+            applied.append(f"{s}_matrix")
+        if R is not None:
+            x = x @ R.T
+        out[s].values[...] = x
+    if R is not None:
+        applied.append("rotation")
+        out.attrs["frame"] = calibration.target_frame
+        if "q_ref" in rec:
+            qR = _quat.from_matrix(R)
+            out["q_ref"].values[...] = _quat.mul(rec["q_ref"].values, _quat.conj(qR))
+    if not applied:
+        raise CalibrationError("the calibration corrects nothing present in this Recording")
+    history.append({"name": calibration.name, "fingerprint": fp, "applied": applied, "calibration": calibration.to_dict()})
+    out.attrs["calibration"] = json.dumps(history)
+    return out
+
+
+class TumbleResult(NamedTuple):
+    """Output of :func:`tumble_calibration`: the ``calibration``, the still ``intervals``,
+    per-period accelerometer statistics ``acc_stats``, the accelerometer ``fit``
+    (:class:`OffsetFit` or :class:`EllipsoidFit`) and ``gyr_stderr`` (°/s)."""
+
+    calibration: Calibration
+    intervals: np.ndarray
+    acc_stats: StaticStats
+    fit: OffsetFit | EllipsoidFit
+    gyr_stderr: np.ndarray
+
+
+def tumble_calibration(rec: xr.Dataset, *, model: str = "offsets", intervals=None, trigger=None,
+                       threshold: float = 3.0, min_duration_s: float = 0.4, full_scale: float | None = None,
+                       name: str = "tumble test") -> TumbleResult:
+    """Offsets (and optionally scale/misalignment) from a tumble-test Recording.
+
+    Detects still periods (:func:`detect_static`, or ``intervals``/``trigger``), averages
+    the accelerometer in each, fits ``model`` = ``"offsets"`` (:func:`fit_offsets`) or
+    ``"ellipsoid"`` (:func:`fit_ellipsoid`, needs ≥ 9 well-spread poses), and takes
+    gyroscope offsets as medians during stillness.
+    """
+    if model not in ("offsets", "ellipsoid"):
+        raise ValueError("model must be 'offsets' or 'ellipsoid'")
+    fs = float(rec.attrs["fs"])
+    acc = rec["acc"].values * _units.conversion_factor(rec["acc"].attrs.get("units", "g"), "g")
+    gyr = rec["gyr"].values * _units.conversion_factor(rec["gyr"].attrs.get("units", "deg/s"), "deg/s")
+    if intervals is None:
+        intervals = detect_static(gyr, fs, trigger=trigger, threshold=threshold, min_duration_s=min_duration_s)
+    stats = static_means(acc, intervals, full_scale=full_scale, min_periods=3 if model == "offsets" else 9)
+    go, gse = gyro_offset(gyr, intervals)
+    if model == "offsets":
+        fit = fit_offsets(stats.mean, sem=stats.sem)
+        cal = Calibration(name=name, acc_offset=fit.offset, gyr_offset=go,
+                          info={"acc_offset_stderr": fit.stderr.tolist(), "gyr_offset_stderr": gse.tolist(),
+                                "n_poses": int(fit.n), "model": model})
+    else:
+        fit = fit_ellipsoid(stats.mean, sem=stats.sem)
+        cal = Calibration(name=name, acc_offset=fit.offset, acc_matrix=fit.matrix, gyr_offset=go,
+                          info={"acc_offset_stderr": fit.offset_stderr.tolist(), "gyr_offset_stderr": gse.tolist(),
+                                "acc_matrix_stderr": fit.matrix_stderr.tolist(), "n_poses": int(fit.n), "model": model})
+    return TumbleResult(cal, np.asarray(intervals), stats, fit, gse)

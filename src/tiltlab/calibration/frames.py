@@ -1,0 +1,198 @@
+r"""Frames: head frame from motion-capture markers, marker quality control, IMU-to-head
+alignment (Kabsch) and device-to-body mounting angles.
+
+* Head frame from three markers (Fayat et al. 2021 [1]_ §2.6.4), with
+  :math:`v_{21} = p_1 - p_2`, :math:`v_{23} = p_3 - p_2`:
+  :math:`h_y = v_{21}/\|v_{21}\|`, :math:`h_z = (v_{23}\times h_y)/\|v_{23}\times h_y\|`,
+  :math:`h_x = h_y \times h_z`. Head tilt is the world vertical :math:`m_z` expressed in
+  :math:`(h_x, h_y, h_z)`.
+* Marker QC (§2.6.3): the frames with the 2 % largest :math:`|d_{12} - \mathrm{median}(d_{12})|`
+  are dropped; the optical tilt uncertainty is :math:`\arctan(\sigma_{d_{12}}/\mathrm{median}(d_{12}))`
+  (0.21 mm → 0.38° in [1]_).
+* IMU→head alignment (§2.6.6): the rotation minimising the distance between the
+  normalised low-passed (< 2 Hz) acceleration in the IMU frame and the vertical in the
+  head frame during stillness — the Kabsch problem [2]_, solved by
+  :meth:`scipy.spatial.transform.Rotation.align_vectors`.
+* Device→body mounting angles from a level-rest acceleration (Benhamou 2023 [3]_ Eq. 1),
+  delegated to :func:`tiltlab.trig.mounting_angles` / :func:`tiltlab.trig.mounting_matrix`.
+
+References
+----------
+.. [1] R. Fayat et al., Sensors 21(18):6318, 2021. doi:10.3390/s21186318
+.. [2] W. Kabsch, "A solution for the best rotation to relate two sets of vectors",
+   Acta Cryst. A32:922–923, 1976. doi:10.1107/S0567739476001873
+.. [3] S. Benhamou, arXiv:2310.05820, 2023. doi:10.48550/arXiv.2310.05820
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+from scipy.signal import butter, sosfiltfilt
+from scipy.spatial.transform import Rotation
+
+from .. import quaternion as _quat
+from .. import trig as _trig
+from ..simulate import mocap as _mocap
+from ._util import CalibrationError, check_fs, vec3
+
+__all__ = [
+    "head_frame_from_markers",
+    "tilt_from_markers",
+    "MarkerQC",
+    "marker_distance_qc",
+    "optical_tilt_uncertainty",
+    "lowpass",
+    "Alignment",
+    "imu_to_head_alignment",
+    "mounting_rotation",
+]
+
+
+def head_frame_from_markers(p1, p2, p3) -> np.ndarray:
+    """Head→world rotation matrices (…, 3, 3) whose columns are h_x, h_y, h_z (Fayat §2.6.4).
+
+    Frames with a missing (NaN) marker give NaN matrices.
+
+    Validates the markers, then calls the single implementation,
+    :func:`tiltlab.simulate.mocap.head_frame_from_markers`.
+    """
+    a, b, c = (np.asarray(p, float) for p in (p1, p2, p3))
+    if a.shape != b.shape or a.shape != c.shape or a.shape[-1] != 3:
+        raise ValueError("p1, p2, p3 must have the same shape (..., 3)")
+    v21, v23 = a - b, c - b
+    n21 = np.linalg.norm(v21, axis=-1)
+    ncz = np.linalg.norm(np.cross(v23, v21), axis=-1)
+    ok = np.isfinite(ncz)  # frames with a missing (NaN) marker give NaN
+    if np.any(n21[ok] == 0) or np.any(ncz[ok] <= 1e-9 * n21[ok] * np.linalg.norm(v23, axis=-1)[ok]):
+        raise CalibrationError("coincident or collinear markers: the head frame is undefined")
+    return _mocap.head_frame_from_markers(a, b, c)
+
+
+def tilt_from_markers(p1, p2, p3) -> np.ndarray:
+    """Head tilt: the world vertical m_z in head coordinates, R(head)ᵀ e_z (…, 3)."""
+    return head_frame_from_markers(p1, p2, p3)[..., 2, :]
+
+
+class MarkerQC(NamedTuple):
+    """``keep`` (N,) frames kept, ``distance`` (N,) d₁₂, ``median``, ``sigma_all``,
+    ``sigma_kept`` (units of the markers), ``tilt_uncertainty_deg``."""
+
+    keep: np.ndarray
+    distance: np.ndarray
+    median: float
+    sigma_all: float
+    sigma_kept: float
+    tilt_uncertainty_deg: float
+
+
+def optical_tilt_uncertainty(sigma, median_distance) -> float:
+    """Optical tilt uncertainty (°): arctan(σ_d / median d) (Fayat §2.6.3)."""
+    if not median_distance > 0:
+        raise ValueError("median_distance must be positive")
+    return float(np.degrees(np.arctan(float(sigma) / float(median_distance))))
+
+
+def marker_distance_qc(p1, p2, *, drop_fraction: float = 0.02) -> MarkerQC:
+    """Drop the ``drop_fraction`` frames with the largest |d₁₂ − median(d₁₂)| (Fayat §2.6.3).
+
+    Frames with a missing marker (NaN) are dropped as well and do not count in the
+    fraction.
+    """
+    a, b = np.asarray(p1, float), np.asarray(p2, float)
+    if a.shape != b.shape or a.shape[-1] != 3:
+        raise ValueError("p1 and p2 must have the same shape (N, 3)")
+    if not 0 <= drop_fraction < 1:
+        raise ValueError("drop_fraction must be in [0, 1)")
+    d = np.linalg.norm(a - b, axis=-1)
+    ok = np.isfinite(d)
+    if ok.sum() < 3:
+        raise CalibrationError("fewer than three frames with both markers")
+    med = float(np.median(d[ok]))
+    dev = np.where(ok, np.abs(d - med), np.inf)
+    n_drop = int(np.ceil(drop_fraction * ok.sum()))
+    keep = ok.copy()
+    if n_drop:
+        keep[np.argsort(dev, kind="stable")[ok.sum() - n_drop: ok.sum()]] = False
+    s_all, s_kept = float(np.std(d[ok], ddof=1)), float(np.std(d[keep], ddof=1))
+    return MarkerQC(keep, d, med, s_all, s_kept, optical_tilt_uncertainty(s_kept, med))
+
+
+def lowpass(x, fs: float, cutoff_hz: float = 2.0, order: int = 2) -> np.ndarray:
+    """Forward–backward Butterworth low-pass (zero phase), as in Fayat §2.6.5."""
+    fs = check_fs(fs)
+    if not 0 < cutoff_hz < fs / 2:
+        raise ValueError("cutoff_hz must be between 0 and the Nyquist frequency")
+    sos = butter(order, cutoff_hz, btype="low", fs=fs, output="sos")
+    return sosfiltfilt(sos, np.asarray(x, float), axis=0)
+
+
+class Alignment(NamedTuple):
+    """``matrix`` (3, 3) IMU→head rotation, ``quaternion`` (4,), ``rms_deg`` RMS angle
+    between aligned IMU gravity and head vertical, ``n`` samples used."""
+
+    matrix: np.ndarray
+    quaternion: np.ndarray
+    rms_deg: float
+    n: int
+
+
+def imu_to_head_alignment(acc, tilt_head, fs: float, *, still=None, cutoff_hz: float = 2.0,
+                          min_spread_deg: float = 5.0) -> Alignment:
+    r"""Rotation R (IMU→head) minimising :math:`\sum_t \|R\,\hat a_t - z^h_t\|^2` over still samples (Kabsch).
+
+    Parameters
+    ----------
+    acc : array_like (N, 3)
+        IMU acceleration (any unit; it is normalised after low-pass filtering).
+    tilt_head : array_like (N, 3)
+        Vertical in the head frame from motion capture (:func:`tilt_from_markers`).
+    fs : float
+        Sampling rate (Hz) of both (already synchronised) streams.
+    still : array_like (N,) of bool, optional
+        Samples to use (immobility); default all finite ones.
+    cutoff_hz : float
+        Low-pass cut-off (2 Hz in Fayat et al.).
+    min_spread_deg : float
+        The rotation about a single gravity direction is unobservable: the used tilts
+        must spread over at least this angle from their mean, else
+        :class:`CalibrationError`.
+    """
+    a = vec3(acc, "acc", ndim=2)
+    z = np.asarray(tilt_head, float)
+    if z.shape != a.shape:
+        raise ValueError("acc and tilt_head must have the same shape")
+    alp = lowpass(a, fs, cutoff_hz)
+    u = alp / np.linalg.norm(alp, axis=1, keepdims=True)
+    use = np.all(np.isfinite(z), axis=1)
+    if still is not None:
+        s = np.asarray(still, bool)
+        if s.shape != (a.shape[0],):
+            raise ValueError("still must have one value per sample")
+        use &= s
+    if use.sum() < 3:
+        raise CalibrationError("fewer than three usable still samples")
+    zu = z[use] / np.linalg.norm(z[use], axis=1, keepdims=True)
+    m = zu.mean(axis=0)
+    spread = np.degrees(np.max(np.arccos(np.clip(zu @ (m / np.linalg.norm(m)), -1, 1))))
+    if spread < min_spread_deg:
+        raise CalibrationError(f"still tilts span only {spread:.2f}° (< {min_spread_deg}°): the rotation about "
+                               "gravity is not determined")
+    rot, rssd = Rotation.align_vectors(zu, u[use])
+    R = rot.as_matrix()
+    ang = _quat.angle_between(u[use] @ R.T, zu)
+    return Alignment(R, _quat.from_scipy(rot), float(np.degrees(np.sqrt(np.mean(ang**2)))), int(use.sum()))
+
+
+def mounting_rotation(acc_rest) -> np.ndarray:
+    r"""Device→body matrix :math:`R_2(\phi^*)R_1(\lambda^*)` from a level-rest acceleration (Benhamou Eq. 1).
+
+    ``acc_rest`` is a tiltlab specific-force reading (or several, averaged) taken with
+    the animal resting level; apply as ``B = M @ D``.
+    """
+    a = vec3(acc_rest, "acc_rest")
+    if a.ndim == 2:
+        a = a.mean(axis=0)
+    phi, lam = _trig.mounting_angles(a)
+    return np.asarray(_trig.mounting_matrix(phi, lam))

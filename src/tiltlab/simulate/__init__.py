@@ -1,0 +1,56 @@
+"""Simulated recordings with ground truth.
+
+* :mod:`~tiltlab.simulate.kinematics` — rat head motion driven by behavioural states
+  (:func:`head_kinematics`, :class:`BehaviourParams`, :class:`Lesion`);
+* :mod:`~tiltlab.simulate.sensor` — IMU error model and freely-moving sessions
+  (:class:`SensorModel`, :func:`apply_sensor_model`, :func:`simulate_session`);
+* :mod:`~tiltlab.simulate.tumble` — tumble tests on a Fibonacci lattice
+  (:func:`tumble_test`, on :func:`tiltlab.sphere.fibonacci_lattice`);
+* :mod:`~tiltlab.simulate.mocap` — head markers and TTL synchronisation
+  (:func:`mocap_markers`, :func:`simulate_mocap_session`);
+* :mod:`~tiltlab.simulate.cohort` — lesion cohorts on disk
+  (:func:`simulate_cohort`, :func:`load_cohort`);
+The statistics that compare simulated with real recordings live in
+:mod:`tiltlab.behavior` (:func:`~tiltlab.behavior.realism_table`).
+
+Every simulated recording is a validated Recording (:mod:`tiltlab.schema`) with its
+ground truth (``q_ref``, ``a_lin``, ``state``, ``true_*`` attrs) and is bit-identical
+for a given seed.
+"""
+
+from .kinematics import STATES, BehaviourParams, Lesion, TrueMotion, behaviour_bouts, head_kinematics, target_tilt
+from .sensor import (
+    ACC_OFFSET_RANGE_G,
+    GYR_OFFSET_RANGE_DPS,
+    SensorModel,
+    apply_sensor_model,
+    draw_sensor,
+    recording_from_motion,
+    simulate_session,
+    true_sensor_values,
+)
+from .tumble import stage_angles, stage_quaternion, tumble_test, zoh_angular_velocity
+from .mocap import MarkerSupport, head_frame_from_markers, mocap_markers, simulate_mocap_session
+from .cohort import (
+    ANAESTHESIA,
+    EFFECTS,
+    FAYAT_GROUPS,
+    HOURS,
+    TIME_POINTS,
+    Cohort,
+    CohortDesign,
+    iter_sessions,
+    load_cohort,
+    session_plan,
+    simulate_cohort,
+)
+
+__all__ = [
+    "STATES", "BehaviourParams", "Lesion", "TrueMotion", "behaviour_bouts", "head_kinematics", "target_tilt",
+    "ACC_OFFSET_RANGE_G", "GYR_OFFSET_RANGE_DPS", "SensorModel", "apply_sensor_model", "draw_sensor",
+    "recording_from_motion", "simulate_session", "true_sensor_values",
+    "stage_angles", "stage_quaternion", "tumble_test", "zoh_angular_velocity",
+    "MarkerSupport", "head_frame_from_markers", "mocap_markers", "simulate_mocap_session",
+    "ANAESTHESIA", "EFFECTS", "FAYAT_GROUPS", "HOURS", "TIME_POINTS", "Cohort", "CohortDesign",
+    "iter_sessions", "load_cohort", "session_plan", "simulate_cohort",
+]

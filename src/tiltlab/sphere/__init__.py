@@ -1,0 +1,78 @@
+r"""Statistics on the unit sphere for any unit-vector series (tilt, heading, posture).
+
+Submodules
+----------
+* :mod:`~tiltlab.sphere.mesh` — Fibonacci lattice, its spherical Delaunay triangulation,
+  exact facet areas, vectorised point location, tilt maps and visited fractions
+  (Fayat et al. 2021, §2.7);
+* :mod:`~tiltlab.sphere.vmf` — von Mises–Fisher maximum likelihood (weighted, exact κ),
+  bootstrap confidence cones, the mean tilt point of a map and its angle to the sagittal
+  plane (Fayat et al. §2.8, §3.3), rotation of a baseline to the pole (Fig. 3e);
+* :mod:`~tiltlab.sphere.kde` — equal-area grids, location- and movement-based vMF kernel
+  density estimation, reference bandwidth, cumulative isopleths, stationarity check
+  (Benhamou 2023, §7);
+* :mod:`~tiltlab.sphere.residence` — residence time and number of visits
+  (Benhamou 2023, App. C).
+
+Everything is re-exported here: ``from tiltlab import sphere; sphere.tilt_map(g)``.
+Map figures (3-D sphere, Lambert azimuthal equal-area with cartopy) are in
+:mod:`tiltlab.spheremaps`.
+"""
+
+from .mesh import (
+    EDGE_EPS,
+    SphereMesh,
+    as_unit_vectors,
+    fibonacci_lattice,
+    from_lonlat,
+    histogram,
+    locate,
+    sphere_mesh,
+    spherical_triangle_area,
+    tilt_map,
+    to_lonlat,
+    triangulate,
+    visited,
+    visited_fraction,
+)
+from .vmf import (
+    ConfidenceCone,
+    VMFFit,
+    a3,
+    a3_inverse,
+    angle,
+    mean_tilt_point,
+    rotate_to_pole,
+    rotation_to_pole,
+    sagittal_angle,
+    vmf_bootstrap,
+    vmf_cap_area,
+    vmf_fit,
+    vmf_logpdf,
+    vmf_pdf,
+    vmf_sample,
+)
+from .kde import (
+    EqualAreaGrid,
+    SphericalKDE,
+    equal_area_grid,
+    grid_for,
+    isopleth_mask,
+    isopleths,
+    kde,
+    mkde,
+    reference_bandwidth,
+    slerp,
+    stationarity_thirds,
+)
+from .residence import Residence, passage_times, residence, residence_series
+
+__all__ = [
+    "EDGE_EPS", "SphereMesh", "as_unit_vectors", "fibonacci_lattice", "from_lonlat", "histogram", "locate",
+    "sphere_mesh", "spherical_triangle_area", "tilt_map", "to_lonlat", "triangulate", "visited", "visited_fraction",
+    "ConfidenceCone", "VMFFit", "a3", "a3_inverse", "angle", "mean_tilt_point", "rotate_to_pole", "rotation_to_pole",
+    "sagittal_angle", "vmf_bootstrap", "vmf_cap_area", "vmf_fit", "vmf_logpdf", "vmf_pdf", "vmf_sample",
+    "EqualAreaGrid", "SphericalKDE", "equal_area_grid", "grid_for", "isopleth_mask", "isopleths", "kde", "mkde",
+    "reference_bandwidth", "slerp", "stationarity_thirds",
+    "Residence", "passage_times", "residence", "residence_series",
+]

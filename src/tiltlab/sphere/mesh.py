@@ -1,0 +1,483 @@
+r"""Triangulated unit sphere: Fibonacci lattice, spherical Delaunay facets, exact areas,
+vectorised point location and tilt maps (Fayat et al. 2021, §2.7 and §3.3).
+
+The vertices are a spherical Fibonacci lattice; the convex hull of points on the unit
+sphere is their spherical Delaunay triangulation (each hull facet's circumscribed
+circle on the sphere is the intersection of the sphere with the facet's plane, and no
+lattice point lies above that plane). Facet areas are the exact spherical-triangle areas
+(spherical excess) from the Van Oosterom–Strackee formula
+
+.. math::
+    \tan\frac{E}{2} = \frac{|a\cdot(b\times c)|}{1 + a\cdot b + b\cdot c + c\cdot a}.
+
+Point location is a numba *visibility walk*: a cube-map look-up table gives, for each
+of ``6 m²`` cells, the facet containing the cell centre; from there the walk crosses
+the edge whose great circle separates the current facet from the query point until the
+point is inside (one or two steps on average). No Python loop runs over samples or
+facets.
+
+**Boundary rule.** A facet is *closed*: a unit vector :math:`p` is inside facet
+:math:`(a,b,c)` (counter-clockwise seen from outside) when the three normalised edge
+tests :math:`p\cdot\widehat{(b\times c)},\;p\cdot\widehat{(c\times a)},\;
+p\cdot\widehat{(a\times b)}` are all :math:`\ge -\varepsilon` (:math:`\varepsilon`
+= ``EDGE_EPS`` rad). A vector on a shared edge or vertex therefore lies in several
+facets; it is assigned to the **lowest-index** one, so every sample is counted exactly
+once.
+
+References
+----------
+.. [1] R. Fayat, V. Delgado Betancourt, T. Goyallon, M. Petremann, P. Liaudet,
+   V. Descossy, L. Reveret, G. P. Dugué, "Inertial measurement of head tilt in rodents:
+   principles and applications to vestibular research", Sensors 21(18):6318, 2021.
+   doi:10.3390/s21186318
+.. [2] A. Van Oosterom, J. Strackee, "The solid angle of a plane triangle", IEEE Trans.
+   Biomed. Eng. BME-30(2):125–126, 1983. doi:10.1109/TBME.1983.325207
+.. [3] Á. González, "Measurement of areas on a sphere using Fibonacci and
+   latitude–longitude lattices", Math. Geosci. 42:49–64, 2010.
+   doi:10.1007/s11004-009-9257-x
+.. [4] O. Devillers, S. Pion, M. Teillaud, "Walking in a triangulation", Int. J. Found.
+   Comput. Sci. 13(2):181–199, 2002. doi:10.1142/S0129054102001047
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import lru_cache
+
+import numpy as np
+import xarray as xr
+from numba import njit, prange
+from scipy.spatial import ConvexHull
+
+__all__ = [
+    "EDGE_EPS",
+    "SphereMesh",
+    "fibonacci_lattice",
+    "spherical_triangle_area",
+    "triangulate",
+    "sphere_mesh",
+    "locate",
+    "histogram",
+    "tilt_map",
+    "visited",
+    "visited_fraction",
+    "as_unit_vectors",
+    "to_lonlat",
+    "from_lonlat",
+]
+
+#: tolerance (rad) of the closed-facet test; vectors closer than this to an edge count as on it
+EDGE_EPS = 1e-12
+_GOLDEN = (1.0 + 5.0**0.5) / 2.0
+
+
+# ---------------------------------------------------------------------------
+# small helpers
+# ---------------------------------------------------------------------------
+
+
+def as_unit_vectors(v, name: str = "vectors", allow_nan: bool = False) -> np.ndarray:
+    """Validate an (N, 3) array of directions and return unit vectors (a new array).
+
+    Rows must be finite and non-zero; with ``allow_nan`` NaN rows stay NaN.
+    """
+    a = np.asarray(v, dtype=float)
+    if a.ndim == 1 and a.shape == (3,):
+        a = a[None, :]
+    if a.ndim != 2 or a.shape[1] != 3:
+        raise ValueError(f"{name} must have shape (N, 3), got {np.shape(v)}")
+    bad = ~np.isfinite(a).all(axis=1)
+    if bad.any() and not allow_nan:
+        raise ValueError(f"{name} contains {int(bad.sum())} non-finite rows")
+    n = np.linalg.norm(a, axis=1)
+    if np.any((n == 0) & ~bad):
+        raise ValueError(f"{name} contains zero vectors (no direction)")
+    with np.errstate(invalid="ignore"):
+        return a / n[:, None]
+
+
+def to_lonlat(v) -> tuple[np.ndarray, np.ndarray]:
+    r"""Longitude :math:`\xi=\mathrm{atan2}(v_y, v_x)` and latitude :math:`\psi=\mathrm{atan2}(v_z,\sqrt{v_x^2+v_y^2})` (rad).
+
+    In the rodent sensor frame (x nose, y left, z up) longitude 0 is the nose, +π/2 the
+    left ear, and latitude +π/2 the dorsal axis.
+    """
+    v = np.asarray(v, float)
+    if v.shape[-1] != 3:
+        raise ValueError(f"vectors must have a last axis of length 3, got {v.shape}")
+    return np.arctan2(v[..., 1], v[..., 0]), np.arctan2(v[..., 2], np.hypot(v[..., 0], v[..., 1]))
+
+
+def from_lonlat(lon, lat) -> np.ndarray:
+    """Unit vectors from longitude and latitude (rad), shape (..., 3); inverse of :func:`to_lonlat`."""
+    lon, lat = np.broadcast_arrays(np.asarray(lon, float), np.asarray(lat, float))
+    c = np.cos(lat)
+    return np.stack([c * np.cos(lon), c * np.sin(lon), np.sin(lat)], axis=-1)
+
+
+# ---------------------------------------------------------------------------
+# lattice, triangulation, areas
+# ---------------------------------------------------------------------------
+
+
+def fibonacci_lattice(n: int = 5000) -> np.ndarray:
+    r"""Spherical Fibonacci lattice of ``n`` nearly uniform unit vectors, shape (n, 3).
+
+    Point :math:`i = 0,\dots,n-1` has :math:`z_i = 1 - (2i+1)/n` (equal-area latitude
+    bands) and longitude :math:`2\pi i/\Phi` with the golden ratio :math:`\Phi` [3]_.
+    """
+    if int(n) != n or n < 1:
+        raise ValueError(f"n must be a positive integer, got {n!r}")
+    i = np.arange(int(n), dtype=float)
+    z = 1.0 - (2.0 * i + 1.0) / n
+    r = np.sqrt(np.clip(1.0 - z * z, 0.0, None))
+    lon = 2.0 * np.pi * ((i / _GOLDEN) % 1.0)
+    return np.column_stack([r * np.cos(lon), r * np.sin(lon), z])
+
+
+def spherical_triangle_area(a, b, c) -> np.ndarray:
+    r"""Exact area (spherical excess, sr) of the spherical triangles with unit-vector corners a, b, c.
+
+    Van Oosterom–Strackee [2]_:
+    :math:`E = 2\,\mathrm{atan2}\big(|a\cdot(b\times c)|,\;1 + a\cdot b + b\cdot c + c\cdot a\big)`,
+    valid for any triangle (the atan2 keeps the right quadrant when the denominator is
+    negative). Inputs broadcast over leading axes; they are normalised first.
+    """
+    a, b, c = (np.asarray(x, float) for x in (a, b, c))
+    for name, x in zip("abc", (a, b, c)):
+        if x.shape[-1] != 3:
+            raise ValueError(f"{name} must have a last axis of length 3, got {x.shape}")
+    a, b, c = (x / np.linalg.norm(x, axis=-1, keepdims=True) for x in (a, b, c))
+    num = np.abs(np.einsum("...i,...i->...", a, np.cross(b, c)))
+    den = 1.0 + np.einsum("...i,...i->...", a, b) + np.einsum("...i,...i->...", b, c) + np.einsum("...i,...i->...", c, a)
+    return 2.0 * np.arctan2(num, den)
+
+
+@dataclass(frozen=True, eq=False)
+class SphereMesh:
+    """A triangulated unit sphere (immutable; arrays are read-only).
+
+    Attributes
+    ----------
+    vertices : (V, 3) unit vectors.
+    faces : (F, 3) int vertex indices, counter-clockwise seen from outside.
+    neighbors : (F, 3) facet across the edge opposite to each corner.
+    areas : (F,) exact spherical areas (sr); they sum to 4π.
+    centroids : (F, 3) normalised planar centroids (unit vectors), used as facet positions.
+    edge_normals : (F, 3, 3) unit normals of the edge great circles (row k: edge opposite corner k).
+    vf_ptr, vf_idx : CSR list of the facets around each vertex.
+    lut : (6·m·m,) start facet of the cube-map look-up cells; ``lut_m`` = m.
+    """
+
+    vertices: np.ndarray
+    faces: np.ndarray
+    neighbors: np.ndarray
+    areas: np.ndarray
+    centroids: np.ndarray
+    edge_normals: np.ndarray
+    vf_ptr: np.ndarray
+    vf_idx: np.ndarray
+    lut: np.ndarray
+    lut_m: int
+
+    @property
+    def n_vertices(self) -> int:
+        return self.vertices.shape[0]
+
+    @property
+    def n_faces(self) -> int:
+        return self.faces.shape[0]
+
+    def area_ratio(self) -> float:
+        """Largest over smallest facet area."""
+        return float(self.areas.max() / self.areas.min())
+
+    def __repr__(self) -> str:
+        return f"SphereMesh(n_vertices={self.n_vertices}, n_faces={self.n_faces}, area_ratio={self.area_ratio():.3f})"
+
+
+def triangulate(vertices, *, lut_m: int | None = None) -> SphereMesh:
+    """Spherical Delaunay triangulation (convex hull) of unit vectors, with areas and a locator.
+
+    Parameters
+    ----------
+    vertices : array_like, shape (V, 3)
+        Directions (normalised here); they must not all lie in one hemisphere's boundary
+        plane (the hull must contain the origin).
+    lut_m : int, optional
+        Cube-map resolution of the point-location table (default ≈ √(F/6)).
+
+    Returns
+    -------
+    SphereMesh
+    """
+    v = as_unit_vectors(vertices, "vertices")
+    if v.shape[0] < 4:
+        raise ValueError("at least 4 vertices are needed")
+    hull = ConvexHull(v)
+    faces = hull.simplices.astype(np.int64).copy()
+    nbr = hull.neighbors.astype(np.int64).copy()
+    if len(hull.vertices) != v.shape[0]:
+        raise ValueError("some vertices are not on the convex hull (duplicates?)")
+    a, b, c = v[faces[:, 0]], v[faces[:, 1]], v[faces[:, 2]]
+    flip = np.einsum("ij,ij->i", a, np.cross(b, c)) < 0
+    faces[flip, 1], faces[flip, 2] = faces[flip, 2].copy(), faces[flip, 1].copy()
+    nbr[flip, 1], nbr[flip, 2] = nbr[flip, 2].copy(), nbr[flip, 1].copy()
+    a, b, c = v[faces[:, 0]], v[faces[:, 1]], v[faces[:, 2]]
+    if np.any(np.einsum("ij,ij->i", hull.equations[:, :3], a) <= 0):  # pragma: no cover - hull sanity
+        raise ValueError("the convex hull does not contain the origin")
+    areas = spherical_triangle_area(a, b, c)
+    cen = a + b + c
+    cen /= np.linalg.norm(cen, axis=1, keepdims=True)
+    en = np.stack([np.cross(b, c), np.cross(c, a), np.cross(a, b)], axis=1)
+    en /= np.linalg.norm(en, axis=2, keepdims=True)
+    nf = faces.shape[0]
+    order = np.argsort(faces.ravel(), kind="stable")
+    vf_idx = (order // 3).astype(np.int64)
+    vf_ptr = np.zeros(v.shape[0] + 1, np.int64)
+    np.cumsum(np.bincount(faces.ravel(), minlength=v.shape[0]), out=vf_ptr[1:])
+    m = int(lut_m) if lut_m is not None else max(4, int(np.ceil(np.sqrt(nf / 6.0))))
+    lut = _build_lut(m, en, nbr, faces, vf_ptr, vf_idx)
+    arrays = dict(vertices=v, faces=faces, neighbors=nbr, areas=areas, centroids=cen, edge_normals=en,
+                  vf_ptr=vf_ptr, vf_idx=vf_idx, lut=lut)
+    for x in arrays.values():
+        x.flags.writeable = False
+    return SphereMesh(**arrays, lut_m=m)
+
+
+@lru_cache(maxsize=8)
+def sphere_mesh(n: int = 5000) -> SphereMesh:
+    """The (cached) triangulated Fibonacci sphere with ``n`` vertices (Fayat et al. used n = 5000)."""
+    return triangulate(fibonacci_lattice(n))
+
+
+# ---------------------------------------------------------------------------
+# numba point location
+# ---------------------------------------------------------------------------
+
+
+@njit(cache=True, inline="always")
+def _cube_cell(p0, p1, p2, m):
+    a0, a1, a2 = abs(p0), abs(p1), abs(p2)
+    if a0 >= a1 and a0 >= a2:
+        k, s, u, w, big = 0, p0 > 0, p1, p2, a0
+    elif a1 >= a2:
+        k, s, u, w, big = 1, p1 > 0, p2, p0, a1
+    else:
+        k, s, u, w, big = 2, p2 > 0, p0, p1, a2
+    iu = int((u / big + 1.0) * 0.5 * m)
+    iw = int((w / big + 1.0) * 0.5 * m)
+    iu = min(max(iu, 0), m - 1)
+    iw = min(max(iw, 0), m - 1)
+    return ((k * 2 + (1 if s else 0)) * m + iu) * m + iw
+
+
+@njit(cache=True, inline="always")
+def _min_test(en, f, p0, p1, p2):
+    d = 1e300
+    for k in range(3):
+        t = en[f, k, 0] * p0 + en[f, k, 1] * p1 + en[f, k, 2] * p2
+        if t < d:
+            d = t
+    return d
+
+
+@njit(cache=True)
+def _walk(en, nbr, faces, vf_ptr, vf_idx, start, p0, p1, p2, eps):
+    nf = en.shape[0]
+    f = start
+    found = -1
+    for _ in range(nf + 3):
+        worst = -eps
+        kk = -1
+        for k in range(3):
+            t = en[f, k, 0] * p0 + en[f, k, 1] * p1 + en[f, k, 2] * p2
+            if t < worst:
+                worst = t
+                kk = k
+        if kk < 0:
+            found = f
+            break
+        f = nbr[f, kk]
+    if found < 0:  # pragma: no cover - the walk terminates on Delaunay triangulations
+        for g in range(nf):
+            if _min_test(en, g, p0, p1, p2) >= -eps:
+                found = g
+                break
+        if found < 0:
+            return -1
+    # boundary rule: lowest-index closed facet containing p
+    if _min_test(en, found, p0, p1, p2) < eps:
+        best = found
+        for c in range(3):
+            vtx = faces[found, c]
+            for j in range(vf_ptr[vtx], vf_ptr[vtx + 1]):
+                g = vf_idx[j]
+                if g < best and _min_test(en, g, p0, p1, p2) >= -eps:
+                    best = g
+        found = best
+    return found
+
+
+@njit(cache=True)
+def _build_lut(m, en, nbr, faces, vf_ptr, vf_idx):
+    lut = np.empty(6 * m * m, np.int64)
+    f = 0
+    for k in range(3):
+        for s in range(2):
+            sign = 1.0 if s == 1 else -1.0
+            for iu in range(m):
+                u = -1.0 + (iu + 0.5) * 2.0 / m
+                for iw in range(m):
+                    w = -1.0 + (iw + 0.5) * 2.0 / m
+                    if k == 0:
+                        p0, p1, p2 = sign, u, w
+                    elif k == 1:
+                        p0, p1, p2 = w, sign, u
+                    else:
+                        p0, p1, p2 = u, w, sign
+                    r = np.sqrt(p0 * p0 + p1 * p1 + p2 * p2)
+                    p0, p1, p2 = p0 / r, p1 / r, p2 / r
+                    f = _walk(en, nbr, faces, vf_ptr, vf_idx, f, p0, p1, p2, 0.0)
+                    lut[_cube_cell(p0, p1, p2, m)] = f
+    return lut
+
+
+@njit(cache=True, parallel=True)
+def _locate_kernel(x, en, nbr, faces, vf_ptr, vf_idx, lut, m, eps, out):
+    for i in prange(x.shape[0]):
+        p0, p1, p2 = x[i, 0], x[i, 1], x[i, 2]
+        r = np.sqrt(p0 * p0 + p1 * p1 + p2 * p2)
+        if not (r > 0.0) or not np.isfinite(r):
+            out[i] = -1
+            continue
+        p0, p1, p2 = p0 / r, p1 / r, p2 / r
+        out[i] = _walk(en, nbr, faces, vf_ptr, vf_idx, lut[_cube_cell(p0, p1, p2, m)], p0, p1, p2, eps)
+
+
+def locate(vectors, mesh: SphereMesh | None = None) -> np.ndarray:
+    """Index of the facet containing each direction (vectorised numba walk).
+
+    Parameters
+    ----------
+    vectors : array_like, shape (N, 3)
+        Directions (any non-zero norm). Rows that are not finite or are zero give -1.
+    mesh : SphereMesh, optional
+        Default :func:`sphere_mesh` (5000 vertices).
+
+    Returns
+    -------
+    numpy.ndarray of int64, shape (N,)
+        Facet index; a vector on a shared edge or vertex goes to the lowest-index facet
+        containing it (closed facets, tolerance ``EDGE_EPS``), so each sample is counted once.
+    """
+    mesh = sphere_mesh() if mesh is None else mesh
+    x = np.asarray(vectors, dtype=float)
+    if x.ndim != 2 or x.shape[1] != 3:
+        raise ValueError(f"vectors must have shape (N, 3), got {x.shape}")
+    x = np.ascontiguousarray(x)
+    out = np.empty(x.shape[0], np.int64)
+    _locate_kernel(x, mesh.edge_normals, mesh.neighbors, mesh.faces, mesh.vf_ptr, mesh.vf_idx, mesh.lut,
+                   mesh.lut_m, EDGE_EPS, out)
+    return out
+
+
+# ---------------------------------------------------------------------------
+# tilt maps
+# ---------------------------------------------------------------------------
+
+
+def histogram(vectors, mesh: SphereMesh | None = None, *, weights=None) -> np.ndarray:
+    """Number of samples (or summed ``weights``) per facet, shape (F,).
+
+    Rows that are NaN (e.g. masked samples) are ignored.
+    """
+    mesh = sphere_mesh() if mesh is None else mesh
+    idx = locate(vectors, mesh)
+    ok = idx >= 0
+    if weights is None:
+        return np.bincount(idx[ok], minlength=mesh.n_faces)
+    w = np.asarray(weights, float)
+    if w.shape != idx.shape:
+        raise ValueError(f"weights must have shape {idx.shape}, got {w.shape}")
+    return np.bincount(idx[ok], weights=w[ok], minlength=mesh.n_faces)
+
+
+def tilt_map(vectors, *, mesh: SphereMesh | None = None, fs: float | None = None, mask=None) -> xr.Dataset:
+    r"""Head-tilt map: counts, time, time fraction and area-normalised density per facet.
+
+    Parameters
+    ----------
+    vectors : array_like, shape (N, 3)
+        Unit-vector series (tilt :math:`g_s`, heading, posture...). NaN rows are skipped.
+    mesh : SphereMesh, optional
+        Default: the cached 5000-vertex Fibonacci triangulation.
+    fs : float, optional
+        Sampling rate (Hz); when given, ``time`` (s) per facet is added.
+    mask : array_like of bool, shape (N,), optional
+        Keep only these samples (e.g. immobility).
+
+    Returns
+    -------
+    xarray.Dataset
+        dims ``facet`` (and ``axis`` for ``centroid``): ``count``, ``fraction`` (of the
+        kept samples), ``density`` = fraction / area (sr⁻¹; integrates to 1), ``time``
+        (s, if ``fs``), coords ``area`` (sr) and ``centroid``.
+    """
+    mesh = sphere_mesh() if mesh is None else mesh
+    x = np.asarray(vectors, float)
+    if mask is not None:
+        mask = np.asarray(mask, bool)
+        if mask.shape != x.shape[:1]:
+            raise ValueError(f"mask must have shape {x.shape[:1]}, got {mask.shape}")
+        x = x[mask]
+    counts = histogram(x, mesh)
+    total = counts.sum()
+    if total == 0:
+        raise ValueError("no valid samples to map")
+    frac = counts / total
+    ds = xr.Dataset(
+        {
+            "count": ("facet", counts, {"units": "1"}),
+            "fraction": ("facet", frac, {"units": "1"}),
+            "density": ("facet", frac / mesh.areas, {"units": "1/sr"}),
+        },
+        coords={"area": ("facet", np.array(mesh.areas), {"units": "sr"}),
+                "centroid": (("facet", "axis"), np.array(mesh.centroids)), "axis": ["x", "y", "z"]},
+        attrs={"n_samples": int(total), "n_vertices": mesh.n_vertices},
+    )
+    if fs is not None:
+        if not np.isfinite(fs) or fs <= 0:
+            raise ValueError(f"fs must be a positive number, got {fs!r}")
+        ds["time"] = ("facet", counts / float(fs), {"units": "s"})
+        ds.attrs["fs"] = float(fs)
+    return ds
+
+
+def _counts(m) -> np.ndarray:
+    if isinstance(m, xr.Dataset):
+        return np.asarray(m["count"].values)
+    return np.asarray(m)
+
+
+def visited(tmap, *, min_count: int = 1) -> np.ndarray:
+    """Binarised map: True for facets with at least ``min_count`` samples (Fayat Fig. 3c–d)."""
+    return _counts(tmap) >= min_count
+
+
+def visited_fraction(tmap, mesh: SphereMesh | None = None, *, min_count: int = 1, by: str = "area") -> float:
+    r"""Fraction of the sphere visited (facets with ≥ ``min_count`` samples).
+
+    ``by="area"`` sums the exact facet areas over :math:`4\pi`; ``by="count"`` is the
+    fraction of facets (Fayat et al.'s measure, which weights every facet equally even
+    though their areas differ by :meth:`SphereMesh.area_ratio`).
+    """
+    mesh = sphere_mesh() if mesh is None else mesh
+    v = visited(tmap, min_count=min_count)
+    if v.shape != (mesh.n_faces,):
+        raise ValueError(f"map has {v.shape[0]} facets, mesh has {mesh.n_faces}")
+    if by == "area":
+        return float(mesh.areas[v].sum() / mesh.areas.sum())
+    if by == "count":
+        return float(v.mean())
+    raise ValueError(f"by must be 'area' or 'count', got {by!r}")

@@ -1,0 +1,275 @@
+r"""Sphere figures: 3-D facet renderings and Lambert azimuthal equal-area (LAEA) maps.
+
+Maps use cartopy's :class:`~cartopy.crs.LambertAzimuthalEqualArea` on a **unit sphere**
+(``Globe(semimajor_axis=1, semiminor_axis=1)``): longitude and latitude are those of the
+direction in the data frame (:func:`tiltlab.sphere.to_lonlat`; for tilt in the rodent
+sensor frame, longitude 0 = nose +x, +90° = left ear +y, latitude 90° = dorsal +z).
+Nothing here downloads data: no coastlines or Natural Earth features are drawn, only
+gridlines, the equator and labelled sensor axes (:func:`offline` can guard a figure).
+
+The LAEA projection preserves areas, so a facet's colour patch has the same share of
+the disc (radius 2 for the whole sphere) as the facet has of the sphere; around the
+antipode of the map centre shapes are strongly distorted, and facets/cells touching it
+are left out.
+
+References
+----------
+.. [1] J. P. Snyder, Map Projections — A Working Manual, USGS Prof. Paper 1395, 1987,
+   pp. 182–190. doi:10.3133/pp1395
+"""
+
+from __future__ import annotations
+
+import contextlib
+import socket
+from collections.abc import Iterator
+
+import matplotlib.pyplot as plt
+import numpy as np
+
+from tiltlab import sphere as S
+
+__all__ = [
+    "unit_globe",
+    "laea",
+    "tilt_projection",
+    "lonlat_deg",
+    "project",
+    "map_axes",
+    "plot_facets",
+    "plot_grid",
+    "plot_isopleths",
+    "plot_mask",
+    "plot_points",
+    "decorate",
+    "sphere_3d",
+    "offline",
+]
+
+SENSOR_AXES = {"+x": (1, 0, 0), "-x": (-1, 0, 0), "+y": (0, 1, 0), "-y": (0, -1, 0), "+z": (0, 0, 1), "-z": (0, 0, -1)}
+
+
+def unit_globe():
+    """A cartopy Globe that is the unit sphere."""
+    import cartopy.crs as ccrs
+
+    return ccrs.Globe(ellipse=None, semimajor_axis=1.0, semiminor_axis=1.0)
+
+
+def laea(centre=(0.0, 0.0, 1.0), *, nose_up: bool | None = None):
+    """LAEA projection centred on the direction ``centre`` (unit sphere).
+
+    For a map centred on +z (a tilt map seen from above the head) ``nose_up`` (default
+    True there) rotates it so that +x (nose) points up and +y (left) points left, as
+    when looking down on the animal; other centres keep +z (north) up.
+    """
+    import cartopy.crs as ccrs
+
+    lon, lat = S.to_lonlat(np.asarray(centre, float) / np.linalg.norm(centre))
+    lon, lat = float(np.degrees(lon)), float(np.degrees(lat))
+    if nose_up is None:
+        nose_up = lat > 89.999
+    if nose_up:
+        lon = 180.0  # north-polar aspect: meridian lon0 points down, so lon 0 (nose) points up
+    return ccrs.LambertAzimuthalEqualArea(central_longitude=lon, central_latitude=lat, globe=unit_globe())
+
+
+def tilt_projection():
+    """The projection of a head-tilt map: centred on the dorsal axis +z, nose up, left ear left."""
+    return laea((0.0, 0.0, 1.0))
+
+
+def lonlat_deg(vectors) -> tuple[np.ndarray, np.ndarray]:
+    """Longitude and latitude (degrees) of directions."""
+    lon, lat = S.to_lonlat(np.asarray(vectors, float))
+    return np.degrees(lon), np.degrees(lat)
+
+
+def _centre(proj) -> np.ndarray:
+    p = proj.proj4_params
+    return S.from_lonlat(np.radians(p.get("lon_0", 0.0)), np.radians(p.get("lat_0", 0.0)))
+
+
+def project(proj, vectors) -> np.ndarray:
+    """Projected map coordinates (..., 2) of directions (cartopy transform from lon/lat on the same globe)."""
+    import cartopy.crs as ccrs
+
+    v = np.asarray(vectors, float)
+    lon, lat = lonlat_deg(v.reshape(-1, 3))
+    xy = proj.transform_points(ccrs.PlateCarree(globe=unit_globe()), lon, lat)[:, :2]
+    return xy.reshape(v.shape[:-1] + (2,))
+
+
+def map_axes(fig, spec=111, centre=(0.0, 0.0, 1.0), **kw):
+    """Add a GeoAxes with the LAEA projection centred on ``centre`` (global extent)."""
+    proj = laea(centre, **kw)
+    ax = fig.add_subplot(spec, projection=proj)
+    ax.set_global()
+    return ax
+
+
+def _far_from_antipode(proj, vectors, min_deg: float) -> np.ndarray:
+    anti = -_centre(proj)
+    return np.asarray(vectors, float) @ anti < np.cos(np.radians(min_deg))
+
+
+def plot_facets(ax, values, mesh: S.SphereMesh | None = None, *, antipode_deg: float = 4.0, **kw):
+    """Colour the facets of a triangulated sphere by ``values`` (F,) on a LAEA GeoAxes (``ax.tripcolor``)."""
+    mesh = S.sphere_mesh() if mesh is None else mesh
+    values = np.asarray(values, float)
+    if values.shape != (mesh.n_faces,):
+        raise ValueError(f"values must have shape ({mesh.n_faces},), got {values.shape}")
+    xy = project(ax.projection, mesh.vertices)
+    ok_v = _far_from_antipode(ax.projection, mesh.vertices, antipode_deg)
+    keep = ok_v[mesh.faces].all(axis=1)
+    kw.setdefault("shading", "flat")
+    kw.setdefault("edgecolors", "none")
+    return ax.tripcolor(xy[:, 0], xy[:, 1], mesh.faces[keep], facecolors=values[keep], transform=ax.projection, **kw)
+
+
+def plot_mask(ax, mask, mesh: S.SphereMesh | None = None, *, color="tab:green", alpha: float = 0.6, **kw):
+    """Fill the facets where ``mask`` is True with one colour (binarised map, Fayat Fig. 3c–d)."""
+    from matplotlib.colors import ListedColormap
+
+    mask = np.asarray(mask, bool)
+    vals = np.where(mask, 1.0, np.nan)
+    cmap = ListedColormap([color])
+    cmap.set_bad(alpha=0.0)
+    return plot_facets(ax, vals, mesh, cmap=cmap, vmin=0, vmax=1, alpha=alpha, **kw)
+
+
+def _grid_xy(ax, grid, antipode_deg):
+    corners = grid.corners()
+    xy = project(ax.projection, corners)
+    far = _far_from_antipode(ax.projection, corners, antipode_deg)
+    bad = ~(far[:-1, :-1] & far[1:, :-1] & far[:-1, 1:] & far[1:, 1:])
+    return xy, bad
+
+
+def plot_grid(ax, kde_or_values, grid=None, *, antipode_deg: float = 4.0, **kw):
+    """Colour the cells of an equal-area grid (a :class:`~tiltlab.sphere.SphericalKDE` or values + grid) on a LAEA map."""
+    if isinstance(kde_or_values, S.SphericalKDE):
+        values, grid = kde_or_values.density, kde_or_values.grid
+    else:
+        values = np.asarray(kde_or_values, float)
+    if grid is None or values.shape != grid.shape:
+        raise ValueError("values must match the grid's shape")
+    xy, bad = _grid_xy(ax, grid, antipode_deg)
+    vals = np.ma.masked_array(values, bad | ~np.isfinite(values))
+    kw.setdefault("shading", "flat")
+    kw.setdefault("rasterized", True)
+    return ax.pcolormesh(xy[..., 0], xy[..., 1], vals, transform=ax.projection, **kw)
+
+
+def plot_isopleths(ax, kde_result, levels=(0.5, 0.95), *, antipode_deg: float = 10.0, **kw):
+    """Draw cumulative isopleth lines (e.g. 0.50 and 0.95) of a spherical KDE on a LAEA map."""
+    grid = kde_result.grid
+    thr = S.isopleths(kde_result, levels=levels)["threshold"].to_numpy()
+    order = np.argsort(thr)
+    c = grid.centres()
+    xy = project(ax.projection, c)
+    far = _far_from_antipode(ax.projection, c, antipode_deg)
+    z = np.ma.masked_array(kde_result.density, ~far)
+    kw.setdefault("colors", "k")
+    kw.setdefault("linewidths", 1.0)
+    cs = ax.contour(xy[..., 0], xy[..., 1], z, levels=thr[order], transform=ax.projection, **kw)
+    return cs
+
+
+def plot_points(ax, vectors, *, antipode_deg: float = 2.0, **kw):
+    """Plot directions (a trajectory or a few points) on a LAEA map; points near the antipode are dropped."""
+    v = np.atleast_2d(np.asarray(vectors, float))
+    xy = project(ax.projection, v)
+    far = _far_from_antipode(ax.projection, v, antipode_deg)
+    xy[~far] = np.nan
+    return ax.plot(xy[:, 0], xy[:, 1], transform=ax.projection, **kw)
+
+
+def decorate(ax, *, labels: dict | None = None, equator: bool = True, grid_step_deg: float = 30.0,
+             gridline_kw: dict | None = None, fontsize: float = 8):
+    """Gridlines (meridians and parallels every ``grid_step_deg``), the equator and labelled sensor axes.
+
+    ``labels`` maps an axis name of ``SENSOR_AXES`` (``"+x"``, ``"-y"``...) to its text;
+    default: ``+x nose, +y left, -x, -y, +z``. Axes within 30° of the map's antipode, or
+    outside the axes' extent, are not labelled.
+    """
+    import cartopy.crs as ccrs
+
+    gk = dict(color="0.55", linewidth=0.4, linestyle=":", alpha=0.9)
+    gk.update(gridline_kw or {})
+    ax.gridlines(crs=ccrs.PlateCarree(globe=unit_globe()), xlocs=np.arange(-180, 181, grid_step_deg),
+                 ylocs=np.arange(-90 + grid_step_deg, 90, grid_step_deg), **gk)
+    if equator:
+        lon = np.radians(np.linspace(-180, 180, 721))
+        plot_points(ax, S.from_lonlat(lon, 0 * lon), color="w", lw=1.2, antipode_deg=1.0)
+        plot_points(ax, S.from_lonlat(lon, 0 * lon), color="k", lw=0.5, ls="--", antipode_deg=1.0)
+    labels = {"+x": "+x (nose)", "+y": "+y (left)", "-x": "−x", "-y": "−y", "+z": "+z", "-z": "−z"} if labels is None else labels
+    for key, text in labels.items():
+        v = np.asarray(SENSOR_AXES[key], float)
+        if not _far_from_antipode(ax.projection, v[None], 30.0)[0]:
+            continue
+        xy = project(ax.projection, v)
+        ax.plot(*xy, "k+", ms=6, transform=ax.projection)
+        ax.annotate(text, xy, xytext=(4, 4), textcoords="offset points", fontsize=fontsize, annotation_clip=True,
+                    bbox=dict(boxstyle="round,pad=0.15", fc="w", ec="none", alpha=0.7))
+    return ax
+
+
+def sphere_3d(ax, values, mesh: S.SphereMesh | None = None, *, cmap="viridis", norm=None, trajectory=None,
+              traj_kw: dict | None = None, elev: float = 35.0, azim: float = -150.0, nan_color="0.85"):
+    """3-D rendering of a triangulated sphere coloured by ``values`` (F,), optionally with a trajectory.
+
+    ``ax`` must be a 3-D axes (``projection="3d"``); NaN values (e.g. unvisited facets)
+    are drawn in ``nan_color``. The trajectory is drawn slightly outside the sphere, only
+    where it faces the viewer, and above the facets.
+    """
+    from matplotlib import colors as mcolors
+    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+
+    mesh = S.sphere_mesh() if mesh is None else mesh
+    values = np.asarray(values, float)
+    norm = norm or mcolors.Normalize(np.nanmin(values), np.nanmax(values))
+    cm = plt.get_cmap(cmap)
+    fc = cm(norm(np.nan_to_num(values, nan=norm.vmin)))
+    fc[~np.isfinite(values)] = mcolors.to_rgba(nan_color)
+    pc = Poly3DCollection(mesh.vertices[mesh.faces], facecolors=fc, edgecolors=(0, 0, 0, 0.08), linewidths=0.1)
+    ax.add_collection3d(pc)
+    ax.view_init(elev=elev, azim=azim)
+    if trajectory is not None:
+        el, az = np.radians(elev), np.radians(azim)
+        view = np.array([np.cos(el) * np.cos(az), np.cos(el) * np.sin(az), np.sin(el)])
+        t = 1.01 * S.as_unit_vectors(trajectory, "trajectory")
+        t[t @ view < 0.05] = np.nan
+        (line,) = ax.plot(t[:, 0], t[:, 1], t[:, 2], **({"color": "w", "lw": 1.0} | (traj_kw or {})))
+        line.set_zorder(pc.get_zorder() + 10)
+        ax.computed_zorder = False
+    for k, lab in zip(range(3), "xyz"):
+        e = np.zeros(3)
+        e[k] = 1.35
+        ax.plot([0, e[0]], [0, e[1]], [0, e[2]], color="k", lw=0.8)
+        ax.text(*(1.08 * e), f"+{lab}", fontsize=9)
+    ax.set_xlim(-1, 1)
+    ax.set_ylim(-1, 1)
+    ax.set_zlim(-1, 1)
+    ax.set_box_aspect((1, 1, 1))
+    ax.set_axis_off()
+    return plt.cm.ScalarMappable(norm=norm, cmap=cm)
+
+
+@contextlib.contextmanager
+def offline() -> Iterator[None]:
+    """Context manager that makes any attempt to open a network connection raise ``RuntimeError``.
+
+    Wrap map drawing in it to prove that no data (coastlines, tiles) is downloaded.
+    """
+    def refuse(*args, **kwargs):
+        raise RuntimeError(f"network access attempted: {args!r}")
+
+    orig_connect, orig_create = socket.socket.connect, socket.create_connection
+    socket.socket.connect = refuse  # type: ignore[assignment]
+    socket.create_connection = refuse  # type: ignore[assignment]
+    try:
+        yield
+    finally:
+        socket.socket.connect = orig_connect  # type: ignore[assignment]
+        socket.create_connection = orig_create  # type: ignore[assignment]

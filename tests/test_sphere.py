@@ -1,0 +1,481 @@
+"""Tests of tiltlab.sphere (triangulated sphere, vMF, spherical KDE, residence) and tiltlab.spheremaps."""
+
+import numpy as np
+import pytest
+import scipy.stats as st
+from hypothesis import given, settings
+from hypothesis import strategies as hs
+
+from tiltlab import quaternion as Q
+from tiltlab import sphere as S
+from tiltlab import trig
+
+
+def unit(rng, n):
+    x = rng.normal(size=(n, 3))
+    return x / np.linalg.norm(x, axis=1, keepdims=True)
+
+
+def brute_locate(mesh, X, tol=1e-9, chunk=4096):
+    """Independent reference: barycentric coordinates of every point in every facet.
+
+    A facet (a, b, c) contains p when p = λa·a + λb·b + λc·c with all λ ≥ -tol; the lowest
+    such facet index is returned, together with how many facets contain each point.
+    Every facet is tested for every point; a float32 dot product with the facet centroid
+    only skips pairs that cannot pass (a triangle lies in the convex cap around its
+    centroid that holds its corners; margin far above float32 rounding).
+    """
+    V, F = mesh.vertices, mesh.faces
+    M = np.stack([V[F[:, 0]], V[F[:, 1]], V[F[:, 2]]], axis=2)
+    Minv = np.linalg.inv(M)
+    C = M.sum(axis=2)
+    C /= np.linalg.norm(C, axis=1, keepdims=True)
+    cos_r = np.min(np.einsum("fi,fik->fk", C, M)) - 1e-4
+    if cos_r <= 0:  # a cap wider than a hemisphere is not convex: no pruning
+        cos_r = -2.0
+    C32 = C.astype(np.float32)
+    out = np.full(len(X), len(F))
+    cnt = np.zeros(len(X), int)
+    for i in range(0, len(X), chunk):
+        xs = X[i:i + chunk]
+        ii, ff = np.nonzero(xs.astype(np.float32) @ C32.T >= cos_r)
+        ok = np.einsum("nij,nj->ni", Minv[ff], xs[ii]).min(axis=1) >= -tol
+        np.minimum.at(out, i + ii[ok], ff[ok])
+        np.add.at(cnt, i + ii[ok], 1)
+    return out, cnt
+
+
+# ---------------------------------------------------------------------------
+# lattice, triangulation, areas
+# ---------------------------------------------------------------------------
+
+
+def test_fibonacci_lattice_is_unit_and_equal_area_in_z():
+    v = S.fibonacci_lattice(1000)
+    assert v.shape == (1000, 3)
+    np.testing.assert_allclose(np.linalg.norm(v, axis=1), 1, atol=1e-14)
+    # one point per equal-area band of height 2/n in z
+    bands = np.floor((1 - v[:, 2]) / (2 / 1000)).astype(int)
+    assert np.array_equal(np.sort(bands), np.arange(1000))
+
+
+def test_default_mesh_areas_sum_to_4pi_and_topology():
+    m = S.sphere_mesh()
+    assert m.n_vertices == 5000 and m.n_faces == 2 * 5000 - 4  # Euler: F = 2V - 4
+    assert abs(m.areas.sum() - 4 * np.pi) < 1e-9
+    assert np.all(m.areas > 0)
+    a, b, c = (m.vertices[m.faces[:, k]] for k in range(3))
+    assert np.all(np.einsum("ij,ij->i", a, np.cross(b, c)) > 0)  # outward orientation
+    assert 1.4 < m.area_ratio() < 1.8  # Fibonacci facets differ by ~1.6x
+    # each neighbour shares the edge opposite the corner
+    for k in range(3):
+        nb = m.neighbors[:, k]
+        edge = np.stack([m.faces[:, (k + 1) % 3], m.faces[:, (k + 2) % 3]], 1)
+        shared = (edge[:, :, None] == m.faces[nb][:, None, :]).any(axis=2).all(axis=1)
+        assert shared.all() and not np.any(nb == np.arange(m.n_faces))
+    assert S.sphere_mesh() is m  # cached
+
+
+def test_spherical_triangle_area_known_cases():
+    assert S.spherical_triangle_area([1, 0, 0], [0, 1, 0], [0, 0, 1]) == pytest.approx(np.pi / 2, abs=1e-15)
+    rng = np.random.default_rng(0)
+    a, b, c = unit(rng, 200), unit(rng, 200), unit(rng, 200)
+
+    def corner(p, q, r):  # angle at p of the spherical triangle pqr
+        t1, t2 = np.cross(p, q), np.cross(p, r)
+        return np.arccos(np.clip(np.sum(t1 * t2, 1) / np.linalg.norm(t1, axis=1) / np.linalg.norm(t2, axis=1), -1, 1))
+
+    girard = corner(a, b, c) + corner(b, c, a) + corner(c, a, b) - np.pi
+    np.testing.assert_allclose(S.spherical_triangle_area(a, b, c), girard, atol=1e-9)
+
+
+@settings(max_examples=15, deadline=None)
+@given(n=hs.integers(0, 300), seed=hs.integers(0, 2**31 - 1))
+def test_random_triangulations_areas_and_location(n, seed):
+    rng = np.random.default_rng(seed)
+    octa = np.vstack([np.eye(3), -np.eye(3)])  # ensures the hull contains the origin
+    mesh = S.triangulate(np.vstack([octa + 1e-3 * rng.normal(size=(6, 3)), unit(rng, n)]))
+    assert abs(mesh.areas.sum() - 4 * np.pi) < 1e-9
+    X = unit(rng, 3000)
+    ref, cnt = brute_locate(mesh, X)
+    assert np.all(cnt >= 1)
+    np.testing.assert_array_equal(S.locate(X, mesh), ref)
+
+
+# ---------------------------------------------------------------------------
+# point location
+# ---------------------------------------------------------------------------
+
+
+def test_locate_matches_brute_force_on_1e5_vectors_with_edges_and_vertices():
+    m = S.sphere_mesh()
+    rng = np.random.default_rng(1)
+    X = unit(rng, 100_000)
+    # 20 000 on edges (great-circle arcs between two corners), 5000 exactly on vertices
+    f = rng.integers(0, m.n_faces, 20_000)
+    k = rng.integers(0, 3, 20_000)
+    a, b = m.vertices[m.faces[f, k]], m.vertices[m.faces[f, (k + 1) % 3]]
+    X[:20_000] = S.slerp(a, b, rng.random(20_000))
+    X[20_000:25_000] = m.vertices[rng.integers(0, m.n_vertices, 5000)]
+    got = S.locate(X, m)
+    ref, cnt = brute_locate(m, X)
+    np.testing.assert_array_equal(got, ref)
+    assert np.all(cnt[25_000:] == 1) and np.all(cnt[:20_000] >= 2) and np.all(cnt[20_000:25_000] >= 3)
+    # every sample counted exactly once
+    assert S.histogram(X, m).sum() == len(X)
+    # vertices go to the lowest-index facet around them
+    vtx = rng.integers(0, m.n_vertices, 300)
+    lowest = [m.vf_idx[m.vf_ptr[v]:m.vf_ptr[v + 1]].min() for v in vtx]
+    np.testing.assert_array_equal(S.locate(m.vertices[vtx], m), lowest)
+
+
+def test_locate_scale_invariant_and_invalid_rows():
+    m = S.sphere_mesh()
+    rng = np.random.default_rng(2)
+    X = unit(rng, 1000)
+    np.testing.assert_array_equal(S.locate(3.7 * X, m), S.locate(X, m))
+    X[3] = np.nan
+    X[5] = 0
+    idx = S.locate(X, m)
+    assert idx[3] == -1 and idx[5] == -1 and np.all(np.delete(idx, [3, 5]) >= 0)
+    with pytest.raises(ValueError):
+        S.locate(np.zeros((4, 2)), m)
+
+
+# ---------------------------------------------------------------------------
+# tilt maps
+# ---------------------------------------------------------------------------
+
+
+def test_tilt_map_counts_time_density():
+    m = S.sphere_mesh()
+    rng = np.random.default_rng(3)
+    g = S.vmf_sample([0.1, 0.2, 1.0], 20, 5000, rng)
+    g[10] = np.nan
+    tm = S.tilt_map(g, fs=100.0)
+    assert int(tm["count"].sum()) == 4999 == tm.attrs["n_samples"]
+    np.testing.assert_allclose(tm["time"].values, tm["count"].values / 100.0)
+    assert float((tm["density"] * tm["area"]).sum()) == pytest.approx(1.0, abs=1e-12)
+    mask = np.arange(5000) < 2500
+    tm2 = S.tilt_map(g, mask=mask)
+    assert int(tm2["count"].sum()) == 2500 - 1
+    assert S.visited(tm).sum() == np.count_nonzero(tm["count"].values)
+    with pytest.raises(ValueError):
+        S.visited_fraction(tm, m, by="volume")
+
+
+def test_visited_fraction_area_vs_count():
+    m = S.sphere_mesh()
+    rng = np.random.default_rng(4)
+    everywhere = S.histogram(unit(rng, 400_000), m)
+    assert S.visited_fraction(everywhere, m) == 1.0 == S.visited_fraction(everywhere, m, by="count")
+    # a cap of known area: the area measure is within the boundary facets' share of the truth
+    x = unit(rng, 400_000)
+    cap = x[x[:, 2] > 0.5]  # cap area 2π(1-0.5) = π -> 1/4 of the sphere
+    frac = S.visited_fraction(S.histogram(cap, m), m)
+    boundary = m.areas[np.abs(m.centroids[:, 2] - 0.5) < 0.04].sum() / (4 * np.pi)
+    assert abs(frac - 0.25) < boundary
+
+
+# ---------------------------------------------------------------------------
+# von Mises-Fisher
+# ---------------------------------------------------------------------------
+
+
+@settings(max_examples=12, deadline=None)
+@given(kappa=hs.floats(0.05, 2000), seed=hs.integers(0, 2**31 - 1))
+def test_vmf_fit_equals_scipy(kappa, seed):
+    rng = np.random.default_rng(seed)
+    mu = unit(rng, 1)[0]
+    x = S.vmf_sample(mu, kappa, 3000, rng)
+    fit = S.vmf_fit(x)
+    mu_s, kappa_s = st.vonmises_fisher.fit(x)
+    np.testing.assert_allclose(fit.mu, mu_s, atol=1e-6)
+    assert fit.kappa == pytest.approx(kappa_s, rel=1e-3)
+
+
+def test_a3_inverse_and_weights():
+    r = np.concatenate([np.geomspace(1e-8, 0.5, 50), 1 - np.geomspace(1e-8, 0.5, 50)])
+    np.testing.assert_allclose(S.a3(S.a3_inverse(r)), r, rtol=1e-10, atol=1e-15)
+    assert S.a3_inverse(0.0) == 0 and np.isinf(S.a3_inverse(1.0))
+    rng = np.random.default_rng(5)
+    x = S.vmf_sample([1, 0, 0], 8, 200, rng)
+    w = rng.integers(0, 5, 200)
+    f1, f2 = S.vmf_fit(x, w), S.vmf_fit(np.repeat(x, w, axis=0))
+    np.testing.assert_allclose(f1.mu, f2.mu, atol=1e-12)
+    assert f1.kappa == pytest.approx(f2.kappa, rel=1e-10)
+    with pytest.raises(ValueError):
+        S.vmf_fit([[1, 0, 0], [-1, 0, 0]])
+
+
+def test_vmf_sampler_and_cap_area():
+    rng = np.random.default_rng(6)
+    for kappa in (0.5, 6.0, 50.0):
+        x = S.vmf_sample([0, 1, 1], kappa, 40_000, rng)
+        c = x @ (np.array([0, 1, 1]) / np.sqrt(2))
+        assert c.mean() == pytest.approx(S.a3(kappa), abs=4 * c.std() / 200)
+        area = S.vmf_cap_area(kappa, 0.8)
+        inside = np.mean(c >= 1 - area / (2 * np.pi))
+        assert inside == pytest.approx(0.8, abs=0.01)
+    # Benhamou §7: the 0.95 isopleth of a vMF with kappa = 6 covers about pi (1/4 of the sphere)
+    assert S.vmf_cap_area(6, 0.95) == pytest.approx(np.pi, rel=2e-3)
+
+
+def test_bootstrap_cone_matches_fisher_and_block_bootstrap_widens():
+    rng = np.random.default_rng(7)
+    n, kappa = 400, 20.0
+    x = S.vmf_sample([0, 0, 1], kappa, n, rng)
+    cone = S.vmf_bootstrap(x, n_boot=1000, rng=1)
+    R = np.linalg.norm(x.sum(0))
+    fisher = np.arccos(1 - (n - R) / R * (20 ** (1 / (n - 1)) - 1))  # Fisher (1953) 95 % cone
+    assert cone.half_angle == pytest.approx(fisher, rel=0.2)
+    assert cone.kappa_low < S.vmf_fit(x).kappa < cone.kappa_high
+    # strongly autocorrelated series: repeat each direction 20 times
+    xs = np.repeat(x, 20, axis=0)
+    iid = S.vmf_bootstrap(xs, n_boot=300, rng=2).half_angle
+    blk = S.vmf_bootstrap(xs, n_boot=300, rng=2, block=100).half_angle
+    assert blk > 2.5 * iid
+    # frequency weights = resampling the underlying samples
+    w = rng.integers(1, 4, n)
+    cw = S.vmf_bootstrap(x, w, n_boot=500, rng=3).half_angle
+    cr = S.vmf_bootstrap(np.repeat(x, w, axis=0), n_boot=500, rng=3).half_angle
+    assert cw == pytest.approx(cr, rel=0.2)
+
+
+def test_mean_tilt_point_from_map_close_to_sample_mean():
+    rng = np.random.default_rng(8)
+    g = S.vmf_sample([0.3, -0.2, 1.0], 15, 20_000, rng)
+    tm = S.tilt_map(g)
+    a = S.mean_tilt_point(tm)
+    b = S.mean_tilt_point(tm["count"].values)
+    np.testing.assert_allclose(a.mu, b.mu)
+    assert S.angle(a.mu, S.vmf_fit(g).mu) < np.radians(0.2)
+
+
+def test_sagittal_angle_sign_left_ear_down_is_positive_for_left_lesion():
+    for alpha in (0.1, 0.5):
+        q = Q.from_rotvec([-alpha, 0.0, 0.0])  # roll about the nose axis: left ear (+y) goes down
+        g = Q.gravity(q)
+        assert np.isclose(Q.rotate(q, [0, 1, 0])[2], -np.sin(alpha))  # the left ear is below the horizon
+        assert S.sagittal_angle(g, "left") == pytest.approx(alpha)
+        assert S.sagittal_angle(g, "right") == pytest.approx(-alpha)
+    # pitch does not change the angle to the sagittal plane
+    assert S.sagittal_angle(Q.gravity(Q.from_rotvec([0, 0.4, 0])), "left") == pytest.approx(0, abs=1e-15)
+    with pytest.raises(ValueError):
+        S.sagittal_angle([0, 0, 1], "up")
+
+
+@settings(max_examples=20, deadline=None)
+@given(seed=hs.integers(0, 2**31 - 1))
+def test_rotate_to_pole_properties(seed):
+    rng = np.random.default_rng(seed)
+    b, v = unit(rng, 1)[0], unit(rng, 50)
+    r = S.rotate_to_pole(v, b)
+    np.testing.assert_allclose(S.rotate_to_pole(b, b), [0, 0, 1], atol=1e-12)
+    np.testing.assert_allclose(r[:, 2], v @ b, atol=1e-12)  # distance to the pole = distance to baseline
+    np.testing.assert_allclose(r @ r.T, v @ v.T, atol=1e-12)
+    R = S.rotation_to_pole(b)
+    np.testing.assert_allclose(np.linalg.det(R), 1, atol=1e-12)
+    np.testing.assert_allclose(S.rotation_to_pole([0, 0, -1]) @ [0, 0, -1], [0, 0, 1])
+
+
+# ---------------------------------------------------------------------------
+# spherical KDE
+# ---------------------------------------------------------------------------
+
+
+def test_kde_equals_direct_sum_of_vmf_kernels():
+    rng = np.random.default_rng(9)
+    x = S.vmf_sample([1, 1, 0.2], 4, 40, rng)
+    w = rng.random(40)
+    grid = S.equal_area_grid(5.0, pole=[0.3, -0.2, 1.0])
+    h = 0.2
+    res = S.kde(x, grid=grid, h=h, weights=w, tol=1e-14)
+    c = grid.centres().reshape(-1, 3)
+    direct = np.array([S.vmf_pdf(c, xi, 1 / h**2) for xi in x]).T @ w / w.sum()
+    np.testing.assert_allclose(res.density.ravel(), direct, rtol=1e-9, atol=1e-12)
+    g = S.kde(x, grid=grid, h=h, weights=w, kernel="gauss", tol=1e-14)
+    np.testing.assert_allclose(g.density, res.density / (1 - np.exp(-2 / h**2)), rtol=1e-12)
+
+
+@settings(max_examples=8, deadline=None)
+@given(kappa=hs.floats(2, 400), h=hs.floats(0.03, 0.6), seed=hs.integers(0, 2**31 - 1))
+def test_kde_integrates_to_one(kappa, h, seed):
+    rng = np.random.default_rng(seed)
+    x = S.vmf_sample(unit(rng, 1)[0], kappa, 500, rng)
+    res = S.kde(x, h=h, cell_deg=1.0)
+    assert res.integral() == pytest.approx(1.0, abs=1e-3)
+    assert res.density.min() >= 0
+
+
+def test_kde_isopleth_area_kappa6_and_reference_bandwidth():
+    rng = np.random.default_rng(10)
+    x = S.vmf_sample([0.2, 0.5, 0.8], 6.0, 50_000, rng)
+    res = S.kde(x)
+    assert res.integral() == pytest.approx(1.0, abs=1e-3)
+    iso = S.isopleths(res, levels=[0.5, 0.95])
+    theory = S.vmf_cap_area(6.0, 0.95)
+    assert iso.loc[0.95, "area"] == pytest.approx(theory, rel=0.05)
+    assert iso.loc[0.5, "area"] == pytest.approx(S.vmf_cap_area(6.0, 0.5), rel=0.05)
+    # Benhamou Fig. 5: n = 3000, kappa = 31.5 -> h_ref = kappa^-1/2 n^-1/6 ~ 0.047 rad
+    y = S.vmf_sample(S.from_lonlat(0, np.pi / 6), 31.5, 3000, rng)
+    h = S.reference_bandwidth(y)
+    assert h == pytest.approx(31.5**-0.5 * 3000 ** (-1 / 6), rel=0.03)
+    assert h == pytest.approx(0.047, abs=0.0015)
+    assert S.reference_bandwidth(y, method="benhamou") == pytest.approx(h, rel=1e-9)
+
+
+def test_isopleths_uniform_and_unequal_cells():
+    grid = S.equal_area_grid(10.0)
+    d = np.full(grid.shape, 1 / (4 * np.pi))
+    iso = S.isopleths(d, grid.cell_area, levels=[0.25, 0.95])
+    np.testing.assert_allclose(iso["area"].to_numpy(), [np.pi, 0.95 * 4 * np.pi], rtol=1e-9)
+    m = S.sphere_mesh(500)
+    dens = 1 + m.centroids[:, 2]  # unnormalised, unequal facet areas
+    iso = S.isopleths(dens, m.areas, levels=[0.5])
+    # exact: density 1+z, mass above z0 is (1-z0)(3+z0)/4 of the total -> z0 = sqrt(2)-1 ... area 2π(1-z0)
+    z0 = -1 + np.sqrt(2.0)
+    assert iso["area"].iloc[0] == pytest.approx(2 * np.pi * (1 - z0), rel=0.02)
+    mask = S.isopleth_mask(dens, 0.5, m.areas)
+    assert (m.areas[mask].sum()) == pytest.approx(iso["area"].iloc[0], rel=0.03)
+
+
+def test_mkde_mass_along_arcs_and_time_weighting():
+    a, b = S.from_lonlat(0.0, 0.0), S.from_lonlat(1.0, 0.0)
+    x = np.stack([a, b])
+    grid = S.equal_area_grid(1.0, pole=[0, 0, 1])
+    mk = S.mkde(x, fs=1.0, grid=grid, h=0.05)
+    lk = S.kde(x, grid=grid, h=0.05)
+    assert mk.integral() == pytest.approx(1.0, abs=1e-3)
+    mid = np.argmin(np.linalg.norm(grid.centres().reshape(-1, 3) - S.slerp(a, b, 0.5), axis=1))
+    assert mk.density.ravel()[mid] > 0.5 / (1.0 * 1.0) and lk.density.ravel()[mid] < 1e-6
+    # a series that stays still: MKDE = KDE of that point
+    still = np.repeat(a[None], 10, axis=0)
+    np.testing.assert_allclose(S.mkde(still, fs=5.0, grid=grid, h=0.05).density, S.kde(a[None], grid=grid, h=0.05).density,
+                               rtol=1e-10)
+    # the Brownian-bridge variant is wider in the middle of the step
+    wide = S.mkde(x, fs=1.0, grid=grid, h=0.05, diffusion=0.05)
+    assert wide.integral() == pytest.approx(1.0, abs=1e-3) and wide.density.ravel()[mid] < mk.density.ravel()[mid]
+
+
+def test_stationarity_thirds_detects_a_drift():
+    rng = np.random.default_rng(11)
+    x = S.vmf_sample([0, 0, 1], 30, 3000, rng)
+    df = S.stationarity_thirds(x)
+    assert list(df.index) == ["first", "second", "third", "all"] and df.attrs["max_angle_deg"] < 2
+    drift = np.concatenate([x[:1000], S.vmf_sample([0, 1, 1], 30, 2000, rng)])
+    assert S.stationarity_thirds(drift).attrs["max_angle_deg"] > 20
+
+
+# ---------------------------------------------------------------------------
+# residence time and visits
+# ---------------------------------------------------------------------------
+
+
+def test_crossing_matches_trig_cap_passage():
+    from tiltlab.sphere.residence import _crossing
+
+    rng = np.random.default_rng(12)
+    n_ok = 0
+    for _ in range(200):
+        mu = unit(rng, 1)[0]
+        r = rng.uniform(0.1, 1.2)
+        I = S.vmf_sample(mu, 50 / r, 1, rng)[0]
+        O = unit(rng, 1)[0]
+        if I @ mu < np.cos(r) or O @ mu >= np.cos(r):
+            continue
+        x = np.stack([I, O])
+        tc = _crossing(x, np.array([0.0, 1.0]), 0, 1, *mu, np.cos(r))
+        (xi_i, psi_i), (xi_o, psi_o), (xi_m, psi_m) = S.to_lonlat(I), S.to_lonlat(O), S.to_lonlat(mu)
+        _, frac, xp, pp = trig.cap_passage(xi_i, psi_i, xi_o, psi_o, xi_m, psi_m, r)
+        assert tc == pytest.approx(float(frac), abs=1e-9)
+        assert S.from_lonlat(xp, pp) @ mu == pytest.approx(np.cos(r), abs=1e-9)
+        n_ok += 1
+    assert n_ok > 50
+
+
+def test_residence_visits_and_passage_times():
+    fs = 50.0
+    t = np.arange(0, 20, 1 / fs)
+    # oscillation along the equator through the centre (lon 0): inside when |lon| < r
+    lon = 0.6 * np.sin(2 * np.pi * t / 4.0)
+    x = S.from_lonlat(lon, 0 * lon)
+    r, centre = 0.3, S.from_lonlat(0.0, 0.0)
+    ent, ext = S.passage_times(x, centre, r, fs=fs)
+    # inside while |sin| < 0.5: 1/3 of the time; passages centred on t = 0, 2, ..., 20 s
+    # (the first and the last are cut by the ends of the series)
+    assert len(ent) == len(ext) == 11 and ent[0] == t[0] and ext[-1] == t[-1]
+    np.testing.assert_allclose(ext[1:-1] - ent[1:-1], 2 / 3, rtol=1e-3)
+    res = S.residence(x, centre[None], r, t_out=0.1, fs=fs)
+    assert res.total[0] == pytest.approx(np.sum(ext - ent)) == pytest.approx((t[-1] - t[0]) / 3, rel=0.01)
+    assert res.n_visits[0] == 11
+    # excursions last 4/3 s: a longer time-out merges every passage into one visit
+    assert S.residence(x, centre[None], r, t_out=2.0, fs=fs).n_visits[0] == 1
+    idx, rt, nv = S.residence_series(x, r, t_out=0.1, fs=fs, stride=25)
+    assert np.array_equal(idx, np.arange(0, len(t), 25)) and np.all(nv >= 1)
+    # sample 0 (t = 0, on the centre) is in the first passage, which starts with the series
+    assert ent[0] == 0.0 and rt[0] == pytest.approx(ext[0] - ent[0], rel=1e-9)
+    # sample 100 (t = 2 s) is on the centre again: its visit is the 2nd passage, 2/3 s long
+    j = np.flatnonzero(idx == 100)[0]
+    assert rt[j] == pytest.approx(ext[1] - ent[1], rel=1e-9) == pytest.approx(2 / 3, rel=0.01)
+    still = np.repeat(centre[None], 100, axis=0)
+    r2 = S.residence(still, centre[None], r, 1.0, fs=10.0)
+    assert r2.n_visits[0] == 1 and r2.total[0] == pytest.approx(9.9)
+    with pytest.raises(ValueError):
+        S.residence(x, centre[None], 2.0, 1.0, fs=fs)
+
+
+# ---------------------------------------------------------------------------
+# maps
+# ---------------------------------------------------------------------------
+
+
+def test_laea_maps_render_offline_and_preserve_area():
+    pytest.importorskip("cartopy")
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from tiltlab import spheremaps as SM
+
+    m = S.sphere_mesh(2000)
+    rng = np.random.default_rng(13)
+    g = S.vmf_sample([0.2, 0.1, 1.0], 10, 3000, rng)
+    tm = S.tilt_map(g, mesh=m)
+    k = S.kde(g, cell_deg=3.0)
+    with SM.offline():
+        fig = plt.figure()
+        ax = SM.map_axes(fig, 121)
+        SM.plot_facets(ax, tm["fraction"].values, m)
+        SM.decorate(ax)
+        ax2 = SM.map_axes(fig, 122, centre=[1, 0, 0])
+        SM.plot_grid(ax2, k)
+        SM.plot_isopleths(ax2, k)
+        fig.canvas.draw()
+        with pytest.raises(RuntimeError):
+            import socket
+
+            socket.create_connection(("example.org", 80))
+    plt.close(fig)
+    # LAEA on the unit sphere preserves area: projected facet areas sum to their spherical areas
+    xy = SM.project(SM.tilt_projection(), m.vertices)
+    keep = m.vertices[m.faces].reshape(-1, 9)[:, 2::3].max(axis=1) > -0.5  # away from the antipode
+    p, q, s = (xy[m.faces[keep, j]] for j in range(3))
+    planar = 0.5 * np.abs((q - p)[:, 0] * (s - p)[:, 1] - (q - p)[:, 1] * (s - p)[:, 0])
+    assert planar.sum() == pytest.approx(m.areas[keep].sum(), rel=2e-3)
+
+
+def test_tilt_map_projection_is_equal_area():
+    from tiltlab import quaternion
+    from tiltlab import spheremaps as SM
+
+    proj = SM.tilt_projection()
+    np.testing.assert_allclose(SM.project(proj, np.array([[0.0, 0.0, 1.0]])), [[0.0, 0.0]], atol=1e-9)
+    eq = SM.project(proj, np.array([[1.0, 0, 0], [0, -1.0, 0]]))
+    np.testing.assert_allclose(np.linalg.norm(eq, axis=-1), np.sqrt(2), rtol=1e-9)
+    g = quaternion.gravity(quaternion.random_quaternions(40000, 1))  # uniform on the sphere
+    keep = g[:, 2] > -0.99  # the antipode maps to a circle
+    r = np.linalg.norm(SM.project(proj, g[keep]), axis=-1)
+    for radius in (0.5, 1.0, 1.5):
+        assert np.sum(r < radius) / g.shape[0] == pytest.approx(radius**2 / 4, abs=0.01)
