@@ -354,3 +354,23 @@ def test_broad_trial_madgwick_reasonable(data_mirror):
     e = F.broad_errors(F.estimate(rec, "madgwick", beta=0.02), rec)
     assert e["inclination"] < 2.0
     assert e["n"] > 0
+
+
+def test_grid_search_dataarray_scores_add_dims_and_must_be_consistent():
+    acc, gyr, _, q_true, fs = _motion(n=400)
+    recs = [make_recording(acc, gyr, fs, acc_units="m/s^2", gyr_units="rad/s", q_ref=q_true)]
+
+    def two(q, rec):
+        e = np.degrees(Q.tilt_error(q, rec["q_ref"].values))
+        return xr.DataArray([e.mean(), e.max()], dims=("stat",), coords={"stat": ["mean", "max"]})
+
+    g = F.grid_search(recs, "madgwick", {"beta": [0.05, 0.5]}, two, n_jobs=1)
+    assert g.dims == ("beta", "recording", "stat") and np.all(g.sel(stat="max") >= g.sel(stat="mean"))
+    calls = iter(range(10))
+
+    def bad(q, rec):
+        n = 2 + next(calls) % 2
+        return xr.DataArray(np.zeros(n), dims=("stat",))
+
+    with pytest.raises(ValueError):
+        F.grid_search(recs, "madgwick", {"beta": [0.05, 0.5]}, bad, n_jobs=1)

@@ -29,6 +29,11 @@ Methods
     post-hoc analysis.
 ``vqf``, ``offline_vqf``
     Adapters to the ``vqf`` package (Laidig & Seel 2023), for comparison.
+``imufusion``
+    Adapter to the ``imufusion`` package (x-io Fusion AHRS, 6D), for comparison.
+``ahrs_madgwick``, ``ahrs_mahony``, ``ahrs_ekf``
+    Adapters to the pure-Python ``ahrs`` package (6D; slow: use short recordings), for
+    comparison; the EKF runs with ``frame='NED'`` (really z up, see below).
 
 Sample indexing
 ---------------
@@ -991,6 +996,10 @@ METHODS: dict[str, dict[str, Any]] = {
     "smoother": {"fc": 0.1, "order": 2},
     "vqf": {},
     "offline_vqf": {},
+    "imufusion": {"gain": 0.5, "acceleration_rejection": 10.0, "rejection_timeout": 5.0},
+    "ahrs_madgwick": {"beta": 0.05},
+    "ahrs_mahony": {"kp": 1.0, "ki": 0.3},
+    "ahrs_ekf": {"var_gyr": 0.3**2, "var_acc": 0.5**2},
 }
 
 
@@ -1024,6 +1033,43 @@ def _vqf_run(acc, gyr, mag, fs, offline: bool, params: dict) -> np.ndarray:
     return np.asarray(res["quat9D" if m is not None else "quat6D"])
 
 
+def _imufusion_run(acc, gyr, fs, gain: float, acceleration_rejection: float, rejection_timeout: float) -> np.ndarray:
+    """x-io Fusion AHRS (``imufusion``), 6D, NWU world (z up: tilt comparable); gyr rad/s → °/s, acc m/s² → g."""
+    import imufusion
+
+    settings = imufusion.AhrsSettings(sample_rate=fs, convention=imufusion.CONVENTION_NWU, gain=float(gain),
+                                      gyroscope_range=1e6, acceleration_rejection=float(acceleration_rejection),
+                                      magnetic_rejection=0.0, rejection_timeout=int(round(rejection_timeout * fs)))
+    a = imufusion.Ahrs()
+    a.set_settings(settings)
+    a.set_sample_period(1.0 / fs)
+    g = np.degrees(gyr)
+    ac = acc / _units.G0
+    out = np.empty((acc.shape[0], 4))
+    for k in range(acc.shape[0]):
+        a.update_no_magnetometer(g[k], ac[k])
+        out[k] = a.get_quaternion()
+    return out
+
+
+def _ahrs_run(name: str, acc, gyr, fs, params: dict) -> np.ndarray:
+    """The pure-Python ``ahrs`` package (6D) with an explicit ``frequency`` and start at
+    :func:`initial_orientation` of the first 0.1 s."""
+    import ahrs.filters as af
+
+    q0 = initial_orientation(acc[: max(1, int(round(0.1 * fs)))])
+    if name == "ahrs_madgwick":
+        f = af.Madgwick(gyr=gyr, acc=acc, frequency=fs, gain=float(params["beta"]), q0=q0)
+    elif name == "ahrs_mahony":
+        # ahrs rejects k_I = 0 (and k_P = 0); the smallest positive float acts as zero
+        f = af.Mahony(gyr=gyr, acc=acc, frequency=fs, k_P=max(float(params["kp"]), 5e-324),
+                      k_I=max(float(params["ki"]), 5e-324), q0=q0)
+    else:
+        f = af.EKF(gyr=gyr, acc=acc, frequency=fs, frame="NED", q0=q0,
+                   noises=[float(params["var_gyr"]), float(params["var_acc"]), 0.8**2])
+    return np.asarray(f.Q, float)
+
+
 def _run(method: str, acc, gyr, mag, fs, params: dict) -> np.ndarray:
     if method == "lowpass":
         if mag is not None:
@@ -1043,6 +1089,12 @@ def _run(method: str, acc, gyr, mag, fs, params: dict) -> np.ndarray:
         return smoother(acc, gyr, fs, **params)
     if method in ("vqf", "offline_vqf"):
         return _vqf_run(acc, gyr, mag, fs, method == "offline_vqf", params)
+    if method == "imufusion" or method.startswith("ahrs_"):
+        if mag is not None:
+            raise ValueError(f"method {method!r} is wrapped in 6D only; use_mag=True is not supported")
+        if method == "imufusion":
+            return _imufusion_run(acc, gyr, fs, **params)
+        return _ahrs_run(method, acc, gyr, fs, params)
     raise ValueError(f"unknown method {method!r}; known: {sorted(METHODS)}")
 
 
@@ -1069,7 +1121,8 @@ def estimate(recording: xr.Dataset, method: str, *, use_mag: bool = False, **par
         A tiltlab Recording (``acc``, ``gyr``, optional ``mag``; attrs ``fs``).
     method : str
         One of ``lowpass, complementary, madgwick, mahony, ekf, smoother, vqf,
-        offline_vqf``.
+        offline_vqf`` or the comparison adapters ``imufusion, ahrs_madgwick,
+        ahrs_mahony, ahrs_ekf``.
     use_mag : bool
         Use the magnetometer (9D, ENU world frame).
     **params
@@ -1208,7 +1261,9 @@ def grid_search(recordings: Sequence[xr.Dataset] | Mapping[Any, xr.Dataset], met
     param_grid : mapping
         Parameter name → sequence of values; the grid is their Cartesian product.
     score_fn : callable
-        ``score_fn(q, rec) -> float``; default :func:`tilt_rmse`.
+        ``score_fn(q, rec) -> float``, or an ``xarray.DataArray`` with the same dims
+        and coords for every call (e.g. one score per behavioural ``state``), whose dims
+        are appended after ``recording``; default :func:`tilt_rmse`.
     n_jobs : int, optional
         Worker threads, default ``os.cpu_count()``.
     fixed : mapping, optional
@@ -1217,8 +1272,8 @@ def grid_search(recordings: Sequence[xr.Dataset] | Mapping[Any, xr.Dataset], met
     Returns
     -------
     xarray.DataArray
-        Dims (one per grid parameter…, ``recording``), attrs ``method``, ``use_mag`` and
-        the fixed parameters.
+        Dims (one per grid parameter…, ``recording``, then the score's own dims),
+        attrs ``method``, ``use_mag`` and the fixed parameters.
     """
     if method not in METHODS:
         raise ValueError(f"unknown method {method!r}; known: {sorted(METHODS)}")
@@ -1246,7 +1301,8 @@ def grid_search(recordings: Sequence[xr.Dataset] | Mapping[Any, xr.Dataset], met
         params = {**base, **{n: values[j][idx] for j, (n, idx) in enumerate(zip(names, ci))}}
         acc, gyr, mag, fs = data[ri]
         q = _run(method, acc, gyr, mag, fs, params)
-        return ci, ri, float(score_fn(q, recs[ri]))
+        s = score_fn(q, recs[ri])
+        return ci, ri, (s if isinstance(s, xr.DataArray) else float(s))
 
     n_jobs = n_jobs or os.cpu_count() or 1
     tasks = [(ci, ri) for ci in combos for ri in range(len(recs))]
@@ -1255,10 +1311,22 @@ def grid_search(recordings: Sequence[xr.Dataset] | Mapping[Any, xr.Dataset], met
     else:
         with ThreadPoolExecutor(max_workers=n_jobs) as ex:
             results = list(ex.map(lambda t: job(*t), tasks))
+    extra_dims: tuple = ()
+    extra_coords: dict = {}
+    first = results[0][2]
+    if isinstance(first, xr.DataArray):
+        extra_dims = first.dims
+        extra_coords = {d: first.coords[d].values for d in first.dims if d in first.coords}
+        out = np.full(shape + first.shape, np.nan)
     for ci, ri, s in results:
+        if extra_dims:
+            if not isinstance(s, xr.DataArray) or s.dims != extra_dims or s.shape != first.shape:
+                raise ValueError("score_fn must return DataArrays of identical dims and shape for every call")
+            s = s.values
         out[ci + (ri,)] = s
     coords = {n: np.asarray(v) if np.asarray(v).dtype != object else list(map(str, v)) for n, v in zip(names, values)}
     coords["recording"] = labels
-    return xr.DataArray(out, dims=tuple(names) + ("recording",), coords=coords, name="score",
+    coords.update(extra_coords)
+    return xr.DataArray(out, dims=tuple(names) + ("recording",) + tuple(extra_dims), coords=coords, name="score",
                         attrs={"method": method, "use_mag": int(bool(use_mag)),
                                **{f"param_{k}": _attr_value(v) for k, v in fixed.items()}})
