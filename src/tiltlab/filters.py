@@ -117,6 +117,7 @@ import xarray as xr
 from numba import njit, prange
 
 from . import quaternion as quat
+from .quaternion import rotate_scalar, zoh_step_scalar
 from . import units as _units
 
 __all__ = [
@@ -179,12 +180,7 @@ def _madgwick_kernel(acc, gyr, mag, use_mag, dt, beta, q0, out):
             if mn > 0.0:
                 mx, my, mz = mx / mn, my / mn, mz / mn
                 # h = R(q) m (earth frame), reference b = (|h_xy|, 0, h_z)
-                tx = 2.0 * (y * mz - z * my)
-                ty = 2.0 * (z * mx - x * mz)
-                tz = 2.0 * (x * my - y * mx)
-                hx = mx + w * tx + (y * tz - z * ty)
-                hy = my + w * ty + (z * tx - x * tz)
-                hz = mz + w * tz + (x * ty - y * tx)
+                hx, hy, hz = rotate_scalar(w, x, y, z, mx, my, mz)
                 bx = np.sqrt(hx * hx + hy * hy)
                 bz = hz
                 f4 = 2.0 * bx * (0.5 - y * y - z * z) + 2.0 * bz * (x * z - w * y) - mx
@@ -480,32 +476,13 @@ def _complementary_kernel(acc, gyr, mag, use_mag, dt, k_acc, k_mag, q0, out):
     out[0, 0], out[0, 1], out[0, 2], out[0, 3] = w, x, y, z
     for k in range(1, acc.shape[0]):
         # exact zero-order-hold propagation q ← q ⊗ exp(ω dt / 2)
-        rx, ry, rz = gyr[k, 0] * dt, gyr[k, 1] * dt, gyr[k, 2] * dt
-        th2 = rx * rx + ry * ry + rz * rz
-        th = np.sqrt(th2)
-        if th < 1e-4:
-            f = 0.5 - th2 / 48.0 + th2 * th2 / 3840.0
-            c = 1.0 - th2 / 8.0 + th2 * th2 / 384.0
-        else:
-            f = np.sin(0.5 * th) / th
-            c = np.cos(0.5 * th)
-        dw, dx, dy, dz = c, f * rx, f * ry, f * rz
-        nw = w * dw - x * dx - y * dy - z * dz
-        nx = w * dx + x * dw + y * dz - z * dy
-        ny = w * dy - x * dz + y * dw + z * dx
-        nz = w * dz + x * dy - y * dx + z * dw
-        w, x, y, z = nw, nx, ny, nz
+        w, x, y, z = zoh_step_scalar(w, x, y, z, gyr[k, 0] * dt, gyr[k, 1] * dt, gyr[k, 2] * dt)
         # accelerometer: rotate the world-frame measured "up" towards e_z (axis horizontal)
         ax, ay, az = acc[k, 0], acc[k, 1], acc[k, 2]
         an = np.sqrt(ax * ax + ay * ay + az * az)
         if an > 0.0 and k_acc > 0.0:
             ax, ay, az = ax / an, ay / an, az / an
-            tx = 2.0 * (y * az - z * ay)
-            ty = 2.0 * (z * ax - x * az)
-            tz = 2.0 * (x * ay - y * ax)
-            gx = ax + w * tx + (y * tz - z * ty)
-            gy = ay + w * ty + (z * tx - x * tz)
-            gz = az + w * tz + (x * ty - y * tx)
+            gx, gy, gz = rotate_scalar(w, x, y, z, ax, ay, az)
             s = np.sqrt(gx * gx + gy * gy)
             if s > 0.0:
                 ang = k_acc * np.arctan2(s, gz)
@@ -519,11 +496,7 @@ def _complementary_kernel(acc, gyr, mag, use_mag, dt, k_acc, k_mag, q0, out):
                 w, x, y, z = nw, nx, ny, nz
         if use_mag and k_mag > 0.0:
             mx, my, mz = mag[k, 0], mag[k, 1], mag[k, 2]
-            tx = 2.0 * (y * mz - z * my)
-            ty = 2.0 * (z * mx - x * mz)
-            tz = 2.0 * (x * my - y * mx)
-            hx = mx + w * tx + (y * tz - z * ty)
-            hy = my + w * ty + (z * tx - x * tz)
+            hx, hy, _ = rotate_scalar(w, x, y, z, mx, my, mz)
             if hx != 0.0 or hy != 0.0:
                 # azimuth of the horizontal field, counter-clockwise from north (+y)
                 phi = np.arctan2(-hx, hy)

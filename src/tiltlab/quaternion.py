@@ -60,18 +60,62 @@ __all__ = [
 ]
 
 
+# ---------------------------------------------------------------- scalar helpers
+# Inlined into every numba kernel that steps or rotates one quaternion at a time
+# (here, in tiltlab.filters and in tiltlab.simulate), so the arithmetic is written once.
+
+
+@njit(cache=True, inline="always")
+def qmul_scalar(aw, ax, ay, az, bw, bx, by, bz):
+    """Hamilton product of two quaternions given by components; returns (w, x, y, z)."""
+    return (
+        aw * bw - ax * bx - ay * by - az * bz,
+        aw * bx + ax * bw + ay * bz - az * by,
+        aw * by - ax * bz + ay * bw + az * bx,
+        aw * bz + ax * by - ay * bx + az * bw,
+    )
+
+
+@njit(cache=True, inline="always")
+def rotvec_to_quat_scalar(rx, ry, rz):
+    """Unit quaternion of the rotation vector (rx, ry, rz), with series below 1e-4 rad."""
+    th2 = rx * rx + ry * ry + rz * rz
+    th = np.sqrt(th2)
+    if th < 1e-4:
+        # sin(th/2)/th and cos(th/2) by series (error < 1e-20)
+        f = 0.5 - th2 / 48.0 + th2 * th2 / 3840.0
+        c = 1.0 - th2 / 8.0 + th2 * th2 / 384.0
+    else:
+        f = np.sin(0.5 * th) / th
+        c = np.cos(0.5 * th)
+    return c, f * rx, f * ry, f * rz
+
+
+@njit(cache=True, inline="always")
+def zoh_step_scalar(w, x, y, z, rx, ry, rz):
+    """q ⊗ exp(r / 2) for the rotation vector r = ω Δt (not renormalised)."""
+    dw, dx, dy, dz = rotvec_to_quat_scalar(rx, ry, rz)
+    return qmul_scalar(w, x, y, z, dw, dx, dy, dz)
+
+
+@njit(cache=True, inline="always")
+def rotate_scalar(w, x, y, z, vx, vy, vz):
+    """R(q) v for one quaternion and one vector, via v + 2w(u×v) + 2u×(u×v)."""
+    tx = 2.0 * (y * vz - z * vy)
+    ty = 2.0 * (z * vx - x * vz)
+    tz = 2.0 * (x * vy - y * vx)
+    return vx + w * tx + (y * tz - z * ty), vy + w * ty + (z * tx - x * tz), vz + w * tz + (x * ty - y * tx)
+
+
 # ---------------------------------------------------------------- kernels
 
 
 @njit(cache=True)
 def _mul_kernel(p, q, out):
     for i in range(p.shape[0]):
-        pw, px, py, pz = p[i, 0], p[i, 1], p[i, 2], p[i, 3]
-        qw, qx, qy, qz = q[i, 0], q[i, 1], q[i, 2], q[i, 3]
-        out[i, 0] = pw * qw - px * qx - py * qy - pz * qz
-        out[i, 1] = pw * qx + px * qw + py * qz - pz * qy
-        out[i, 2] = pw * qy - px * qz + py * qw + pz * qx
-        out[i, 3] = pw * qz + px * qy - py * qx + pz * qw
+        out[i, 0], out[i, 1], out[i, 2], out[i, 3] = qmul_scalar(
+            p[i, 0], p[i, 1], p[i, 2], p[i, 3], q[i, 0], q[i, 1], q[i, 2], q[i, 3]
+        )
 
 
 @njit(cache=True)
@@ -81,13 +125,7 @@ def _rotate_kernel(q, v, inverse, out):
         w, x, y, z = q[i, 0], q[i, 1], q[i, 2], q[i, 3]
         if inverse:
             x, y, z = -x, -y, -z
-        vx, vy, vz = v[i, 0], v[i, 1], v[i, 2]
-        tx = 2.0 * (y * vz - z * vy)
-        ty = 2.0 * (z * vx - x * vz)
-        tz = 2.0 * (x * vy - y * vx)
-        out[i, 0] = vx + w * tx + (y * tz - z * ty)
-        out[i, 1] = vy + w * ty + (z * tx - x * tz)
-        out[i, 2] = vz + w * tz + (x * ty - y * tx)
+        out[i, 0], out[i, 1], out[i, 2] = rotate_scalar(w, x, y, z, v[i, 0], v[i, 1], v[i, 2])
 
 
 @njit(cache=True)
@@ -167,20 +205,7 @@ def _to_rotvec_kernel(q, out):
 @njit(cache=True)
 def _from_rotvec_kernel(r, out):
     for i in range(r.shape[0]):
-        rx, ry, rz = r[i, 0], r[i, 1], r[i, 2]
-        th2 = rx * rx + ry * ry + rz * rz
-        th = np.sqrt(th2)
-        if th < 1e-4:
-            # sin(th/2)/th and cos(th/2) by series (error < 1e-20)
-            f = 0.5 - th2 / 48.0 + th2 * th2 / 3840.0
-            c = 1.0 - th2 / 8.0 + th2 * th2 / 384.0
-        else:
-            f = np.sin(0.5 * th) / th
-            c = np.cos(0.5 * th)
-        out[i, 0] = c
-        out[i, 1] = f * rx
-        out[i, 2] = f * ry
-        out[i, 3] = f * rz
+        out[i, 0], out[i, 1], out[i, 2], out[i, 3] = rotvec_to_quat_scalar(r[i, 0], r[i, 1], r[i, 2])
 
 
 @njit(cache=True)
@@ -196,12 +221,7 @@ def _gravity_kernel(q, out):
 def _error_angles_kernel(p, q, out):
     # columns: total, heading, inclination of the Earth-frame error e = p ⊗ q⁻¹
     for i in range(p.shape[0]):
-        pw, px, py, pz = p[i, 0], p[i, 1], p[i, 2], p[i, 3]
-        qw, qx, qy, qz = q[i, 0], -q[i, 1], -q[i, 2], -q[i, 3]
-        w = pw * qw - px * qx - py * qy - pz * qz
-        x = pw * qx + px * qw + py * qz - pz * qy
-        y = pw * qy - px * qz + py * qw + pz * qx
-        z = pw * qz + px * qy - py * qx + pz * qw
+        w, x, y, z = qmul_scalar(p[i, 0], p[i, 1], p[i, 2], p[i, 3], q[i, 0], -q[i, 1], -q[i, 2], -q[i, 3])
         aw = abs(w)
         out[i, 0] = 2.0 * np.arctan2(np.sqrt(x * x + y * y + z * z), aw)
         if aw == 0.0 and z == 0.0:
@@ -227,20 +247,7 @@ def _integrate_kernel(omega, dt, q0, out):
     w, x, y, z = q0[0], q0[1], q0[2], q0[3]
     out[0, 0], out[0, 1], out[0, 2], out[0, 3] = w, x, y, z
     for k in range(omega.shape[0] - 1):
-        rx, ry, rz = omega[k, 0] * dt, omega[k, 1] * dt, omega[k, 2] * dt
-        th2 = rx * rx + ry * ry + rz * rz
-        th = np.sqrt(th2)
-        if th < 1e-4:
-            f = 0.5 - th2 / 48.0 + th2 * th2 / 3840.0
-            c = 1.0 - th2 / 8.0 + th2 * th2 / 384.0
-        else:
-            f = np.sin(0.5 * th) / th
-            c = np.cos(0.5 * th)
-        dw, dx, dy, dz = c, f * rx, f * ry, f * rz
-        nw = w * dw - x * dx - y * dy - z * dz
-        nx = w * dx + x * dw + y * dz - z * dy
-        ny = w * dy - x * dz + y * dw + z * dx
-        nz = w * dz + x * dy - y * dx + z * dw
+        nw, nx, ny, nz = zoh_step_scalar(w, x, y, z, omega[k, 0] * dt, omega[k, 1] * dt, omega[k, 2] * dt)
         n = np.sqrt(nw * nw + nx * nx + ny * ny + nz * nz)
         w, x, y, z = nw / n, nx / n, ny / n, nz / n
         out[k + 1, 0], out[k + 1, 1], out[k + 1, 2], out[k + 1, 3] = w, x, y, z

@@ -42,6 +42,7 @@ import numpy as np
 from numba import njit
 
 from .. import quaternion as _quat
+from ..quaternion import zoh_step_scalar
 
 __all__ = [
     "STATES",
@@ -583,20 +584,7 @@ def _kinematics_kernel(n, dt, b_start, table, q0, d, k_tilt, tau_w, tau_p, arena
         vy += ay * dt
         vz += az * dt
         # ---- orientation: q <- q ⊗ exp(ω dt / 2), the same operations as integrate_gyro
-        rx, ry, rz = w0 * dt, w1 * dt, w2 * dt
-        th2 = rx * rx + ry * ry + rz * rz
-        th = np.sqrt(th2)
-        if th < 1e-4:
-            f = 0.5 - th2 / 48.0 + th2 * th2 / 3840.0
-            c = 1.0 - th2 / 8.0 + th2 * th2 / 384.0
-        else:
-            f = np.sin(0.5 * th) / th
-            c = np.cos(0.5 * th)
-        dw, dx, dy, dz = c, f * rx, f * ry, f * rz
-        nw = w * dw - x * dx - y * dy - z * dz
-        nx = w * dx + x * dw + y * dz - z * dy
-        ny = w * dy - x * dz + y * dw + z * dx
-        nz = w * dz + x * dy - y * dx + z * dw
+        nw, nx, ny, nz = zoh_step_scalar(w, x, y, z, w0 * dt, w1 * dt, w2 * dt)
         nn = np.sqrt(nw * nw + nx * nx + ny * ny + nz * nz)
         w, x, y, z = nw / nn, nx / nn, ny / nn, nz / nn
         # ---- filters and noises
