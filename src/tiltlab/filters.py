@@ -238,23 +238,10 @@ def _mahony_kernel(acc, gyr, mag, use_mag, dt, kp, ki, q0, b0, out, bias):
             mn = np.sqrt(mx * mx + my * my + mz * mz)
             if mn > 0.0:
                 mx, my, mz = mx / mn, my / mn, mz / mn
-                r00 = 1.0 - 2.0 * (y * y + z * z)
-                r01 = 2.0 * (x * y - w * z)
-                r02 = 2.0 * (x * z + w * y)
-                r10 = 2.0 * (x * y + w * z)
-                r11 = 1.0 - 2.0 * (x * x + z * z)
-                r12 = 2.0 * (y * z - w * x)
-                r20 = 2.0 * (x * z - w * y)
-                r21 = 2.0 * (w * x + y * z)
-                r22 = 1.0 - 2.0 * (x * x + y * y)
-                hx = r00 * mx + r01 * my + r02 * mz
-                hy = r10 * mx + r11 * my + r12 * mz
-                hz = r20 * mx + r21 * my + r22 * mz
+                hx, hy, hz = rotate_scalar(w, x, y, z, mx, my, mz)
                 # expected field in the sensor frame: R^T (0, |h_xy|, h_z) (ENU: y north)
                 hn = np.sqrt(hx * hx + hy * hy)
-                wx = r10 * hn + r20 * hz
-                wy = r11 * hn + r21 * hz
-                wz = r12 * hn + r22 * hz
+                wx, wy, wz = rotate_scalar(w, -x, -y, -z, 0.0, hn, hz)
                 wn = np.sqrt(wx * wx + wy * wy + wz * wz)
                 wx, wy, wz = wx / wn, wy / wn, wz / wn
                 ex += my * wz - mz * wy
@@ -343,18 +330,7 @@ def _ekf_h_rows(H, row, v, w, x, y, z):
 @njit(cache=True, nogil=True)
 def _ekf_h_pred(hp, row, v, w, x, y, z):
     # R(q)^T v for a unit q
-    r00 = 1.0 - 2.0 * (y * y + z * z)
-    r01 = 2.0 * (x * y - w * z)
-    r02 = 2.0 * (x * z + w * y)
-    r10 = 2.0 * (x * y + w * z)
-    r11 = 1.0 - 2.0 * (x * x + z * z)
-    r12 = 2.0 * (y * z - w * x)
-    r20 = 2.0 * (x * z - w * y)
-    r21 = 2.0 * (w * x + y * z)
-    r22 = 1.0 - 2.0 * (x * x + y * y)
-    hp[row] = r00 * v[0] + r10 * v[1] + r20 * v[2]
-    hp[row + 1] = r01 * v[0] + r11 * v[1] + r21 * v[2]
-    hp[row + 2] = r02 * v[0] + r12 * v[1] + r22 * v[2]
+    hp[row], hp[row + 1], hp[row + 2] = rotate_scalar(w, -x, -y, -z, v[0], v[1], v[2])
 
 
 @njit(cache=True, nogil=True)

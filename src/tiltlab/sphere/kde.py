@@ -50,7 +50,7 @@ import numpy as np
 import pandas as pd
 from numba import njit, prange
 
-from .mesh import as_unit_vectors, to_lonlat
+from .mesh import _series, as_unit_vectors, to_lonlat
 from .vmf import _frame, angle, vmf_fit
 
 __all__ = [
@@ -385,18 +385,10 @@ def mkde(vectors, *, fs: float | None = None, times=None, grid: EqualAreaGrid | 
     step : maximal sub-arc length (rad), default h/2.
     max_gap : steps longer than this (s) are dropped (data gaps).
     """
-    x = as_unit_vectors(vectors, "vectors")
+    x, t = _series(vectors, fs, times)
     n = x.shape[0]
     if n < 2:
         raise ValueError("need at least 2 samples")
-    if times is None:
-        if fs is None or not np.isfinite(fs) or fs <= 0:
-            raise ValueError("give fs (Hz) or times (s)")
-        t = np.arange(n) / float(fs)
-    else:
-        t = np.asarray(times, float)
-        if t.shape != (n,) or np.any(np.diff(t) <= 0):
-            raise ValueError("times must be strictly increasing with shape (N,)")
     if diffusion < 0:
         raise ValueError("diffusion must be >= 0")
     h = reference_bandwidth(x) if h is None else float(h)

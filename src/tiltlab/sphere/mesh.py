@@ -481,3 +481,18 @@ def visited_fraction(tmap, mesh: SphereMesh | None = None, *, min_count: int = 1
     if by == "count":
         return float(v.mean())
     raise ValueError(f"by must be 'area' or 'count', got {by!r}")
+
+
+def _series(vectors, fs, times):
+    """Unit vectors (N, 3) and their times (s) from ``fs`` (Hz) or explicit strictly increasing ``times``."""
+    x = as_unit_vectors(vectors, "vectors")
+    n = x.shape[0]
+    if times is None:
+        if fs is None or not np.isfinite(fs) or fs <= 0:
+            raise ValueError("give fs (Hz) or times (s)")
+        t = np.arange(n) / float(fs)
+    else:
+        t = np.asarray(times, float)
+        if t.shape != (n,) or np.any(np.diff(t) <= 0):
+            raise ValueError("times must be strictly increasing with shape (N,)")
+    return x, t

@@ -41,7 +41,7 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit, prange
 
-from .mesh import as_unit_vectors
+from .mesh import _series, as_unit_vectors
 
 __all__ = ["Residence", "passage_times", "residence", "residence_series"]
 
@@ -123,20 +123,6 @@ def _residence_kernel(x, t, centres, cos_r, t_out, tref, total, nvis, rt):
         total[m] = tot
         nvis[m] = nv
         rt[m] = res
-
-
-def _series(vectors, fs, times):
-    x = as_unit_vectors(vectors, "vectors")
-    n = x.shape[0]
-    if times is None:
-        if fs is None or not np.isfinite(fs) or fs <= 0:
-            raise ValueError("give fs (Hz) or times (s)")
-        t = np.arange(n) / float(fs)
-    else:
-        t = np.asarray(times, float)
-        if t.shape != (n,) or np.any(np.diff(t) <= 0):
-            raise ValueError("times must be strictly increasing with shape (N,)")
-    return x, t
 
 
 def _check(radius, t_out):
