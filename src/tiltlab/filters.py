@@ -119,6 +119,7 @@ from numba import njit, prange
 from . import quaternion as quat
 from .quaternion import rotate_scalar, zoh_step_scalar
 from . import units as _units
+from .units import check_fs as _check_fs
 
 __all__ = [
     "METHODS",
@@ -489,18 +490,6 @@ def _complementary_kernel(acc, gyr, mag, use_mag, dt, k_acc, k_mag, q0, out):
 
 
 # ====================================================================== helpers
-
-
-def _check_fs(fs) -> float:
-    if fs is None:
-        raise ValueError("fs (sampling rate, Hz) is mandatory; tiltlab never assumes a default")
-    try:
-        fs = float(fs)
-    except (TypeError, ValueError):
-        raise ValueError(f"fs must be a number of Hz, got {fs!r}") from None
-    if not np.isfinite(fs) or fs <= 0:
-        raise ValueError(f"fs must be a positive finite number of Hz, got {fs!r}")
-    return fs
 
 
 def _vec(a, name: str, n: int | None = None) -> np.ndarray:

@@ -68,6 +68,8 @@ from typing import Literal, NamedTuple
 
 import numpy as np
 
+from .units import check_fs as _check_fs
+
 __all__ = [
     # notation and frames
     "R1",
@@ -248,12 +250,6 @@ def _as_benhamou(acc, convention: Convention, name: str = "acc") -> np.ndarray:
     if convention == "benhamou":
         return acc.copy()
     raise ValueError(f"convention must be 'tiltlab' or 'benhamou', got {convention!r}")
-
-
-def _check_fs(fs) -> float:
-    if fs is None or not np.isfinite(fs) or fs <= 0:
-        raise ValueError(f"fs must be a positive number of Hz, got {fs!r}")
-    return float(fs)
 
 
 def _clip1(x):

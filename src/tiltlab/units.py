@@ -20,6 +20,7 @@ __all__ = [
     "acc_to_g",
     "gyr_to_rad_s",
     "check_gyro_units",
+    "check_fs",
 ]
 
 #: Standard gravity (m/s²), the conversion factor between g and m/s² (CGPM 1901).
@@ -141,6 +142,22 @@ def acc_to_g(values, units: str) -> np.ndarray:
 def gyr_to_rad_s(values, units: str) -> np.ndarray:
     """Angular velocity in rad/s from ``units`` ('deg/s' or 'rad/s')."""
     return convert(values, units, "rad/s")
+
+
+def check_fs(fs) -> float:
+    """A sampling rate as a positive finite float (Hz); ``None`` or anything else is an error.
+
+    tiltlab never assumes a default sampling rate.
+    """
+    if fs is None:
+        raise ValueError("fs (sampling rate, Hz) is mandatory; tiltlab never assumes a default")
+    try:
+        fs = float(fs)
+    except (TypeError, ValueError):
+        raise ValueError(f"fs must be a number of Hz, got {fs!r}") from None
+    if not np.isfinite(fs) or fs <= 0:
+        raise ValueError(f"fs must be a positive finite number of Hz, got {fs!r}")
+    return fs
 
 
 def check_gyro_units(

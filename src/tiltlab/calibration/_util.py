@@ -4,18 +4,11 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..units import check_fs
+
 
 class CalibrationError(ValueError):
     """Calibration input cannot support the requested fit, or a calibration was misapplied."""
-
-
-def check_fs(fs) -> float:
-    if fs is None:
-        raise ValueError("fs (sampling rate, Hz) is mandatory")
-    fs = float(fs)
-    if not np.isfinite(fs) or fs <= 0:
-        raise ValueError(f"fs must be a positive finite number of Hz, got {fs!r}")
-    return fs
 
 
 def vec3(x, name: str, *, ndim: int | None = None) -> np.ndarray:
