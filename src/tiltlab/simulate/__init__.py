@@ -24,6 +24,7 @@ from .sensor import (
     GYR_OFFSET_RANGE_DPS,
     SensorModel,
     apply_sensor_model,
+    magnetometer_readings,
     draw_sensor,
     recording_from_motion,
     simulate_session,
@@ -47,7 +48,7 @@ from .cohort import (
 
 __all__ = [
     "STATES", "BehaviourParams", "Lesion", "TrueMotion", "behaviour_bouts", "head_kinematics", "target_tilt",
-    "ACC_OFFSET_RANGE_G", "GYR_OFFSET_RANGE_DPS", "SensorModel", "apply_sensor_model", "draw_sensor",
+    "ACC_OFFSET_RANGE_G", "GYR_OFFSET_RANGE_DPS", "SensorModel", "apply_sensor_model", "draw_sensor", "magnetometer_readings",
     "recording_from_motion", "simulate_session", "true_sensor_values",
     "stage_angles", "stage_quaternion", "tumble_test", "zoh_angular_velocity",
     "MarkerSupport", "head_frame_from_markers", "mocap_markers", "simulate_mocap_session",

@@ -43,6 +43,7 @@ from ..units import G0
 from .kinematics import STATES, BehaviourParams, Lesion, TrueMotion, head_kinematics
 
 __all__ = [
+    "magnetometer_readings",
     "SensorModel",
     "apply_sensor_model",
     "simulate_session",
@@ -320,19 +321,37 @@ def apply_sensor_model(true: dict, sensor: SensorModel | None, rng: np.random.Ge
     if s.magnetometer:
         if "q" not in true:
             raise ValueError("a magnetometer needs the true orientation 'q'")
-        dip = math.radians(s.dip_deg)
-        m_w = s.field_uT * np.array([0.0, math.cos(dip), -math.sin(dip)])
-        m_true = _quat.rotate_inverse(true["q"], m_w)
-        mag = m_true @ np.asarray(s.mag_soft_iron).T + np.asarray(s.mag_hard_iron)
-        if s.mag_noise_uT > 0:
-            mag += s.mag_noise_uT * rng.standard_normal((n, 3))
-        if s.quantize:
-            mag = np.round(mag / 0.15) * 0.15  # AK8963 16-bit output: 0.15 µT/LSB
-        out["mag"] = mag
+        out["mag"], m_w = magnetometer_readings(true["q"], s, rng)
         truth.update({"true_mag_hard_iron": np.asarray(s.mag_hard_iron, float).tolist(), "true_mag_soft_iron": np.asarray(s.mag_soft_iron).tolist(),
                       "true_field_world_uT": m_w.tolist()})
     out["truth"] = truth
     return out
+
+
+def magnetometer_readings(q, sensor: SensorModel, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
+    r"""Magnetometer output (µT) of a drawn sensor (:func:`draw_sensor`) at orientations ``q``.
+
+    The local field in ENU is :math:`m_w = B\,(0, \cos I, -\sin I)` (strength ``field_uT``,
+    dip ``dip_deg``, pointing down in the northern hemisphere); the sensor reads
+    :math:`W R(q)^\top m_w + h + n` with soft iron :math:`W`, hard iron :math:`h` and white
+    noise :math:`n`, quantised to the AK8963's 0.15 µT when ``sensor.quantize``.
+
+    Returns
+    -------
+    mag : numpy.ndarray, shape (N, 3)
+        Readings (µT).
+    m_w : numpy.ndarray, shape (3,)
+        The world-frame field (µT).
+    """
+    q = np.asarray(q, float)
+    dip = math.radians(sensor.dip_deg)
+    m_w = sensor.field_uT * np.array([0.0, math.cos(dip), -math.sin(dip)])
+    mag = _quat.rotate_inverse(q, m_w) @ np.asarray(sensor.mag_soft_iron, float).T + np.asarray(sensor.mag_hard_iron, float)
+    if sensor.mag_noise_uT > 0:
+        mag += sensor.mag_noise_uT * rng.standard_normal(mag.shape)
+    if sensor.quantize:
+        mag = np.round(mag / 0.15) * 0.15  # AK8963 16-bit output: 0.15 µT/LSB
+    return mag, m_w
 
 
 def true_sensor_values(q, a_lin_g) -> np.ndarray:
