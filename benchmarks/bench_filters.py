@@ -45,6 +45,7 @@ def main() -> None:
     ap.add_argument("--n", type=int, default=1_000_000, help="samples for tiltlab kernels")
     ap.add_argument("--n-ref", type=int, default=20_000, help="samples for the (slow) ahrs reference")
     ap.add_argument("--grid", type=int, default=30, help="number of gain values in the grid")
+    ap.add_argument("--n-offline", type=int, default=100_000, help="samples for the offline smoothers")
     args = ap.parse_args()
     n, n_ref = args.n, args.n_ref
 
@@ -92,6 +93,22 @@ def main() -> None:
         else:
             print(f"{name:18s} {r_ours / 1e6:22.2f} {'-':>19s} {'-':>8s}")
         rows.append((name, r_ours))
+
+    # ---- offline methods (6D): the error-state RTS smoother stores a 15x15 covariance per
+    # sample (1.8 kB), so it runs on at most --n-offline samples; offlineVQF in the same run
+    no = min(n, args.n_offline)
+    a_o, g_o = acc[:no], gyr[:no]
+    F.rts_smoother(a_o[:200], g_o[:200], fs)  # warm-up
+    offline = [("rts_smoother 6D", lambda: F.rts_smoother(a_o, g_o, fs)),
+               ("rts forward only", lambda: F.rts_smoother(a_o, g_o, fs, smooth=False)),
+               ("smoother 6D", lambda: F.smoother(a_o, g_o, fs)),
+               ("offlineVQF 6D", lambda: F._vqf_run(a_o, g_o, None, fs, True, {}))]
+    print(f"\noffline methods, N = {no:,} samples (samples/s):")
+    r_off = {}
+    for name, fn in offline:
+        r_off[name] = no / best_of(fn, repeat=2)
+        print(f"{name:18s} {r_off[name] / 1e6:10.3f} M/s")
+    print(f"rts_smoother / offlineVQF throughput ratio: {r_off['rts_smoother 6D'] / r_off['offlineVQF 6D']:.2f}")
 
     # ---- gain grid: 30 values over N samples, 2 workers
     betas = np.geomspace(0.002, 0.5, args.grid)
