@@ -501,3 +501,11 @@ def test_rts_smoother_estimate_grid_and_bad_inputs():
         F.rts_smoother(acc, gyr, 100.0, tau=0.0)
     with pytest.raises(ValueError, match="fs"):
         F.rts_smoother(acc, gyr, None)
+
+
+def test_rts_smoother_refuses_recordings_too_large_for_memory():
+    acc = np.tile([0.0, 0.0, 9.81], (1000, 1))
+    gyr = np.zeros((1000, 3))
+    with pytest.raises(ValueError, match="split the recording"):
+        F.rts_smoother(acc, gyr, 100.0, max_memory_gb=1e-6)
+    assert F.rts_smoother(acc, gyr, 100.0, smooth=False, max_memory_gb=1e-6).shape == (1000, 4)

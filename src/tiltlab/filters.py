@@ -1243,7 +1243,8 @@ def rts_smoother(acc, gyr, fs: float, *, gyr_noise: float = 5e-3, bias_noise: fl
                  acc_std: float = 0.05, norm_gain: float = 10.0, vel_std: float = 0.3, pos_std: float = 1.0,
                  tau: float = 1.0, zupt_std: float = 0.01, bias_std: float = np.radians(0.5), scale_std: float = 0.0,
                  scale_noise: float = 0.0, bias=None, q0=None,
-                 init_window: float = 0.1, smooth: bool = True, return_state: bool = False):
+                 init_window: float = 0.1, smooth: bool = True, return_state: bool = False,
+                 max_memory_gb: float = 4.0):
     r"""Offline attitude smoother: error-state (multiplicative) EKF with gyro-bias, gyro-scale,
     velocity and position states, followed by a Rauch–Tung–Striebel backward pass.
 
@@ -1341,6 +1342,9 @@ def rts_smoother(acc, gyr, fs: float, *, gyr_noise: float = 5e-3, bias_noise: fl
         Run the backward pass (``False``: forward filter only).
     return_state : bool
         Also return the (smoothed) states :math:`(b, v, p, s)`, shape (N, 12).
+    max_memory_gb : float
+        Refuse recordings whose stored covariances would exceed this (1.8 kB per sample,
+        e.g. 0.65 GB for 20 min at 300 Hz); split longer recordings or raise the limit.
 
     Returns
     -------
@@ -1360,6 +1364,12 @@ def rts_smoother(acc, gyr, fs: float, *, gyr_noise: float = 5e-3, bias_noise: fl
     fs = _check_fs(fs)
     acc = _vec(acc, "acc")
     gyr = _vec(gyr, "gyr", acc.shape[0])
+    need_gb = acc.shape[0] * 15 * 15 * 8 / 1e9
+    if smooth and need_gb > max_memory_gb:
+        raise ValueError(
+            f"rts_smoother would store {need_gb:.1f} GB of covariances for {acc.shape[0]} samples "
+            f"(limit max_memory_gb={max_memory_gb:g}); split the recording into shorter segments or raise the limit"
+        )
     dt = 1.0 / fs
     names = ("gyr_noise", "bias_noise", "acc_noise")
     sig = [_positive(v, nm, allow_zero=True) for v, nm in zip((gyr_noise, bias_noise, acc_noise), names)]
