@@ -18,6 +18,7 @@ import numpy as np
 from tiltlab import filters as F
 from tiltlab import quaternion as Q
 from tiltlab.schema import make_recording
+from _timing import best_of
 
 
 def synthetic(n: int, fs: float = 200.0, seed: int = 0):
@@ -29,15 +30,6 @@ def synthetic(n: int, fs: float = 200.0, seed: int = 0):
     mag = Q.rotate_inverse(q, [0.0, 20.0, -40.0]) + 0.5 * rng.standard_normal((n, 3))
     gyr = omega + 0.02 * rng.standard_normal((n, 3)) + np.array([0.01, -0.02, 0.005])
     return acc, gyr, mag, q, fs
-
-
-def best_of(fn, repeat: int = 3) -> float:
-    times = []
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - t0)
-    return min(times)
 
 
 def main() -> None:

@@ -9,16 +9,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from tiltlab import quaternion as Q
-
-
-def best_of(fn, repeat=5):
-    fn()  # warm-up (numba compilation, caches)
-    times = []
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - t0)
-    return min(times)
+from _timing import best_of
 
 
 def main(n: int = 1_000_000) -> None:
@@ -40,10 +31,10 @@ def main(n: int = 1_000_000) -> None:
     ]
     print(f"{'operation':>15} {'tiltlab Msamples/s':>20} {'scipy Msamples/s':>18} {'ratio':>7}   (N = {n:,})")
     for name, ours, ref in cases:
-        t = best_of(ours)
+        t = best_of(ours, 5, warmup=True)
         line = f"{name:>15} {n / t / 1e6:20.1f}"
         if ref is not None:
-            tr = best_of(ref)
+            tr = best_of(ref, 5, warmup=True)
             line += f" {n / tr / 1e6:18.1f} {tr / t:7.1f}"
         print(line)
 

@@ -12,15 +12,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from tiltlab import sphere as S
-
-
-def best_of(fn, repeat=3):
-    times = []
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - t0)
-    return min(times)
+from _timing import best_of
 
 
 def main(n_bin: int = 1_000_000, n_kde: int = 100_000) -> None:

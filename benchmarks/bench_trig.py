@@ -12,15 +12,11 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 import tiltlab.trig as trig
+from _timing import best_of as _best_of
 
 
-def best(f, repeat: int = 5) -> float:
-    ts = []
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        f()
-        ts.append(time.perf_counter() - t0)
-    return min(ts)
+def best_of(fn, repeat: int = 5) -> float:
+    return _best_of(fn, repeat)
 
 
 def main(n: int = 1_000_000) -> None:
@@ -31,12 +27,12 @@ def main(n: int = 1_000_000) -> None:
     f, m = trig.acc_from_angles(ph, la), trig.mag_from_angles(th, ph, la)
     eul = np.column_stack([th, -ph, la])
     rows = [
-        ("angles -> quaternion", best(lambda: trig.angles_to_quaternion(th, ph, la)),
-         best(lambda: Rotation.from_euler("ZYX", eul).as_quat(scalar_first=True))),
-        ("quaternion -> angles", best(lambda: trig.angles_from_quaternion(q)), best(lambda: rot.as_euler("ZYX"))),
-        ("heading (Eqs. 3, 5) from acc+mag", best(lambda: trig.heading(f, m)), None),
-        ("arc (Eq. 7)", best(lambda: trig.arc(th, ph, np.roll(th, 1), np.roll(ph, 1))), None),
-        ("Eq. 11 + Eqs. 12-13", best(lambda: trig.azimuth_change(ph, la, ph, la, *trig.simultaneous_rotations(ph, la, th))), None),
+        ("angles -> quaternion", best_of(lambda: trig.angles_to_quaternion(th, ph, la)),
+         best_of(lambda: Rotation.from_euler("ZYX", eul).as_quat(scalar_first=True))),
+        ("quaternion -> angles", best_of(lambda: trig.angles_from_quaternion(q)), best_of(lambda: rot.as_euler("ZYX"))),
+        ("heading (Eqs. 3, 5) from acc+mag", best_of(lambda: trig.heading(f, m)), None),
+        ("arc (Eq. 7)", best_of(lambda: trig.arc(th, ph, np.roll(th, 1), np.roll(ph, 1))), None),
+        ("Eq. 11 + Eqs. 12-13", best_of(lambda: trig.azimuth_change(ph, la, ph, la, *trig.simultaneous_rotations(ph, la, th))), None),
     ]
     print(f"n = {n:,} samples")
     for name, t, t_ref in rows:
@@ -45,7 +41,7 @@ def main(n: int = 1_000_000) -> None:
             line += f"   scipy {n / t_ref / 1e6:8.2f} M/s   ratio tiltlab/scipy speed = {t_ref / t:5.2f}"
         print(line)
     acc = rng.normal(size=(n, 3))
-    t = best(lambda: trig.dba(acc, 100.0, 1.0), 3)
+    t = best_of(lambda: trig.dba(acc, 100.0, 1.0), 3)
     print(f"{'DBA (sliding 1 s window @100 Hz)':36s} {n / t / 1e6:8.2f} M samples/s")
 
 
