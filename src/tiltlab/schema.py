@@ -27,6 +27,7 @@ import numpy as np
 import xarray as xr
 
 from . import units as _units
+from ._validate import RecordingError
 
 __all__ = [
     "AXES",
@@ -51,8 +52,6 @@ _QUANTITY = {**VECTOR_VARS, "temp": "temperature", "q_ref": "dimensionless"}
 _PROVENANCE = ("source", "sensor", "subject", "session")
 
 
-class RecordingError(ValueError):
-    """A Recording breaks the data contract; the message names what is wrong."""
 
 
 def make_recording(

@@ -144,22 +144,6 @@ def gyr_to_rad_s(values, units: str) -> np.ndarray:
     return convert(values, units, "rad/s")
 
 
-def check_fs(fs) -> float:
-    """A sampling rate as a positive finite float (Hz); ``None`` or anything else is an error.
-
-    tiltlab never assumes a default sampling rate.
-    """
-    if fs is None:
-        raise ValueError("fs (sampling rate, Hz) is mandatory; tiltlab never assumes a default")
-    try:
-        fs = float(fs)
-    except (TypeError, ValueError):
-        raise ValueError(f"fs must be a number of Hz, got {fs!r}") from None
-    if not np.isfinite(fs) or fs <= 0:
-        raise ValueError(f"fs must be a positive finite number of Hz, got {fs!r}")
-    return fs
-
-
 def check_gyro_units(
     gyr,
     gyr_units: str,
@@ -232,3 +216,7 @@ def check_gyro_units(
             "Fix the 'units' attribute, or pass check_units=False to validate()."
         )
     return ratio
+
+
+# one implementation, in the validation module (imported last: it imports this module)
+from ._validate import check_fs  # noqa: E402

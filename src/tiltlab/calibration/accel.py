@@ -40,7 +40,7 @@ from typing import NamedTuple
 import numpy as np
 from scipy.optimize import least_squares
 
-from ..simulate import tumble as _tumble
+from ..frames import fibonacci_lattice, stage_angles, stage_quaternion
 from ._util import CalibrationError, mat3, vec3
 
 __all__ = [
@@ -419,11 +419,8 @@ def fit_known_directions(points, directions, *, max_condition: float = 1e3) -> L
 # ---------------------------------------------------------------------------- design
 
 
-# The lattice and the stage geometry are implemented once, in tiltlab.simulate.tumble
-# (Fayat App. A.1); calibration re-exports them under the names used in this chapter.
-from ..sphere.mesh import fibonacci_lattice  # noqa: E402  (one implementation: tiltlab.sphere)
-stage_angles = _tumble.stage_angles
-stage_quaternion = _tumble.stage_quaternion
+# The lattice and the stage geometry are implemented once, in tiltlab.frames
+# (Fayat App. A.1); calibration re-exports them under the names used in its chapter.
 
 
 def lattice_subset(directions, k: int) -> np.ndarray:

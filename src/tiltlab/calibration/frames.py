@@ -33,8 +33,7 @@ from scipy.signal import butter, sosfiltfilt
 from scipy.spatial.transform import Rotation
 
 from .. import quaternion as _quat
-from .. import trig as _trig
-from ..simulate import mocap as _mocap
+from .. import frames as _frames
 from ._util import CalibrationError, check_fs, vec3
 
 __all__ = [
@@ -56,7 +55,7 @@ def head_frame_from_markers(p1, p2, p3) -> np.ndarray:
     Frames with a missing (NaN) marker give NaN matrices.
 
     Validates the markers, then calls the single implementation,
-    :func:`tiltlab.simulate.mocap.head_frame_from_markers`.
+    :func:`tiltlab.frames.head_frame_from_markers`.
     """
     a, b, c = (np.asarray(p, float) for p in (p1, p2, p3))
     if a.shape != b.shape or a.shape != c.shape or a.shape[-1] != 3:
@@ -67,7 +66,7 @@ def head_frame_from_markers(p1, p2, p3) -> np.ndarray:
     ok = np.isfinite(ncz)  # frames with a missing (NaN) marker give NaN
     if np.any(n21[ok] == 0) or np.any(ncz[ok] <= 1e-9 * n21[ok] * np.linalg.norm(v23, axis=-1)[ok]):
         raise CalibrationError("coincident or collinear markers: the head frame is undefined")
-    return _mocap.head_frame_from_markers(a, b, c)
+    return _frames.head_frame_from_markers(a, b, c)
 
 
 def tilt_from_markers(p1, p2, p3) -> np.ndarray:
@@ -194,5 +193,5 @@ def mounting_rotation(acc_rest) -> np.ndarray:
     a = vec3(acc_rest, "acc_rest")
     if a.ndim == 2:
         a = a.mean(axis=0)
-    phi, lam = _trig.mounting_angles(a)
-    return np.asarray(_trig.mounting_matrix(phi, lam))
+    phi, lam = _frames.mounting_angles(a)
+    return np.asarray(_frames.mounting_matrix(phi, lam))

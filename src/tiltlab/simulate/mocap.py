@@ -32,6 +32,7 @@ import numpy as np
 import xarray as xr
 
 from .. import quaternion as _quat
+from ..frames import head_frame_from_markers
 from .kinematics import BehaviourParams, Lesion, TrueMotion, head_kinematics
 from .sensor import SensorModel, recording_from_motion
 
@@ -51,18 +52,6 @@ class MarkerSupport:
         m = np.asarray(self.markers_mm, float)
         if m.ndim != 2 or m.shape[1] != 3 or m.shape[0] < 3:
             raise ValueError(f"markers_mm must be (M >= 3, 3), got {m.shape}")
-
-
-def head_frame_from_markers(m1, m2, m3) -> np.ndarray:
-    r"""Head frame of Fayat §2.6.4 from markers 1–3: rotation matrices (..., 3, 3) whose
-    columns are :math:`h_x, h_y, h_z` in mocap (world) coordinates."""
-    m1, m2, m3 = (np.asarray(v, float) for v in (m1, m2, m3))
-    hy = m1 - m2
-    hy = hy / np.linalg.norm(hy, axis=-1, keepdims=True)
-    hz = np.cross(m3 - m2, hy)
-    hz = hz / np.linalg.norm(hz, axis=-1, keepdims=True)
-    hx = np.cross(hy, hz)
-    return np.stack([hx, hy, hz], axis=-1)
 
 
 def _nlerp(q, u):

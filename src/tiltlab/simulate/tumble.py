@@ -29,29 +29,12 @@ import numpy as np
 import xarray as xr
 
 from .. import quaternion as _quat
-from ..sphere.mesh import fibonacci_lattice
+from ..frames import fibonacci_lattice, stage_angles, stage_quaternion
 from .sensor import SensorModel, apply_sensor_model, true_sensor_values
 from .. import schema as _schema
 
 __all__ = ["stage_angles", "stage_quaternion", "tumble_test", "zoh_angular_velocity"]
 
-
-
-def stage_angles(g) -> tuple[np.ndarray, np.ndarray]:
-    r"""Stage pitch β and roll γ (rad) bringing gravity-up to ``g`` in the sensor frame."""
-    g = np.asarray(g, float)
-    if g.shape[-1] != 3:
-        raise ValueError(f"g must have last dimension 3, got {g.shape}")
-    g = g / np.linalg.norm(g, axis=-1, keepdims=True)
-    # atan2 form of beta = -asin(g_x): accurate near the poles too
-    return np.arctan2(-g[..., 0], np.hypot(g[..., 1], g[..., 2])), np.arctan2(g[..., 1], g[..., 2])
-
-
-def stage_quaternion(pitch, roll) -> np.ndarray:
-    """Orientation ``R_y(pitch) R_x(roll)`` (sensor → world) of the two-axis stage."""
-    pitch, roll = np.broadcast_arrays(np.asarray(pitch, float), np.asarray(roll, float))
-    z = np.zeros_like(pitch)
-    return _quat.mul(_quat.from_rotvec(np.stack([z, pitch, z], -1)), _quat.from_rotvec(np.stack([roll, z, z], -1)))
 
 
 def zoh_angular_velocity(q, fs: float) -> np.ndarray:

@@ -49,6 +49,8 @@ import xarray as xr
 from numba import njit, prange
 from scipy.spatial import ConvexHull
 
+from ..frames import fibonacci_lattice
+
 __all__ = [
     "EDGE_EPS",
     "SphereMesh",
@@ -68,7 +70,6 @@ __all__ = [
 
 #: tolerance (rad) of the closed-facet test; vectors closer than this to an edge count as on it
 EDGE_EPS = 1e-12
-_GOLDEN = (1.0 + 5.0**0.5) / 2.0
 
 
 # ---------------------------------------------------------------------------
@@ -118,21 +119,6 @@ def from_lonlat(lon, lat) -> np.ndarray:
 # ---------------------------------------------------------------------------
 # lattice, triangulation, areas
 # ---------------------------------------------------------------------------
-
-
-def fibonacci_lattice(n: int = 5000) -> np.ndarray:
-    r"""Spherical Fibonacci lattice of ``n`` nearly uniform unit vectors, shape (n, 3).
-
-    Point :math:`i = 0,\dots,n-1` has :math:`z_i = 1 - (2i+1)/n` (equal-area latitude
-    bands) and longitude :math:`2\pi i/\Phi` with the golden ratio :math:`\Phi` [3]_.
-    """
-    if int(n) != n or n < 1:
-        raise ValueError(f"n must be a positive integer, got {n!r}")
-    i = np.arange(int(n), dtype=float)
-    z = 1.0 - (2.0 * i + 1.0) / n
-    r = np.sqrt(np.clip(1.0 - z * z, 0.0, None))
-    lon = 2.0 * np.pi * ((i / _GOLDEN) % 1.0)
-    return np.column_stack([r * np.cos(lon), r * np.sin(lon), z])
 
 
 def spherical_triangle_area(a, b, c) -> np.ndarray:

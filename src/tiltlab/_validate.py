@@ -1,0 +1,350 @@
+"""One validation module: how every public function reads its inputs and reports problems.
+
+Layer 1 (beside :mod:`tiltlab.units`). Every science function that takes data calls
+:func:`signal` (or :func:`vectors` / the scalar checks) instead of writing its own checks,
+so that the same mistake gives the same message everywhere.
+
+Policy
+------
+* **Error** (:class:`RecordingError` for data, :class:`ValueError` for parameters):
+  anything that would give a wrong number — a missing or contradictory sampling rate or
+  unit, a wrong shape, a non-finite or out-of-domain parameter. The message names the
+  argument (or attribute) and the value.
+* **Repair with a warning**, recorded in the output's attrs: reserved for cases where the
+  right answer is unambiguous (none in this module).
+* **NaN with a warning**: quantities that are undefined for some samples (e.g. heading at a
+  magnetic pole) — decided by the function that computes them.
+
+Reading labelled data
+---------------------
+:func:`signal` accepts, for one input named e.g. ``"gyr"``:
+
+* a Recording (:class:`xarray.Dataset`): the variable ``gyr``, the dataset's ``fs`` and the
+  variable's ``units``;
+* a labelled :class:`xarray.DataArray`: its values, ``attrs["fs"]`` and ``attrs["units"]``;
+* a plain array: the values, with ``fs`` and ``units`` given as arguments.
+
+An ``fs`` or ``units`` given as an argument must agree with the one in the attrs; a
+``time`` coordinate must agree with ``fs``. A missing one, where the function needs it,
+is an error naming it.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+import xarray as xr
+
+__all__ = [
+    "RecordingError",
+    "Signal",
+    "signal",
+    "labelled",
+    "vectors",
+    "check_fs",
+    "positive",
+    "finite",
+    "nonnegative",
+    "integer",
+    "fraction",
+]
+
+
+class RecordingError(ValueError):
+    """A Recording breaks the data contract; the message names what is wrong."""
+
+
+# --------------------------------------------------------------------------- scalars
+
+
+def check_fs(fs, name: str = "fs") -> float:
+    """A sampling rate as a positive finite float (Hz); ``None`` or anything else is an error.
+
+    tiltlab never assumes a default sampling rate.
+    """
+    if fs is None:
+        raise ValueError(
+            f"{name} (sampling rate, Hz) is mandatory; tiltlab never assumes a default"
+        )
+    if isinstance(fs, bool):
+        raise ValueError(f"{name} must be a number of Hz, got {fs!r}")
+    try:
+        value = float(fs)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be a number of Hz, got {fs!r}") from None
+    if not np.isfinite(value) or value <= 0:
+        raise ValueError(f"{name} must be a positive finite number of Hz, got {fs!r}")
+    return value
+
+
+def _number(value, name: str) -> float:
+    if isinstance(value, bool) or value is None:
+        raise ValueError(f"{name} must be a number, got {value!r}")
+    try:
+        return float(value)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be a number, got {value!r}") from None
+
+
+def finite(value, name: str) -> float:
+    """``value`` as a finite float, else a :class:`ValueError` naming ``name``."""
+    v = _number(value, name)
+    if not np.isfinite(v):
+        raise ValueError(f"{name} must be finite, got {value!r}")
+    return v
+
+
+def positive(value, name: str, *, allow_zero: bool = False, allow_inf: bool = False) -> float:
+    """``value`` as a positive float (``> 0``, or ``>= 0`` with ``allow_zero``)."""
+    v = _number(value, name)
+    if np.isnan(v) or (np.isinf(v) and not allow_inf) or v < 0 or (v == 0 and not allow_zero):
+        kind = "non-negative" if allow_zero else "positive"
+        raise ValueError(f"{name} must be a {kind} number, got {value!r}")
+    return v
+
+
+def nonnegative(value, name: str) -> float:
+    """``value`` as a finite float ``>= 0``."""
+    return positive(value, name, allow_zero=True)
+
+
+def integer(value, name: str, *, minimum: int | None = None) -> int:
+    """``value`` as an int (integral floats accepted), at least ``minimum`` if given."""
+    if isinstance(value, bool) or value is None:
+        raise ValueError(f"{name} must be an integer, got {value!r}")
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be an integer, got {value!r}") from None
+    if not np.isfinite(v) or v != int(v):
+        raise ValueError(f"{name} must be an integer, got {value!r}")
+    if minimum is not None and v < minimum:
+        raise ValueError(f"{name} must be at least {minimum}, got {value!r}")
+    return int(v)
+
+
+def fraction(value, name: str, *, open_low: bool = False, open_high: bool = False) -> float:
+    """``value`` as a float in [0, 1] (ends excluded with ``open_low`` / ``open_high``)."""
+    v = finite(value, name)
+    if v < 0 or v > 1 or (open_low and v == 0) or (open_high and v == 1):
+        lo = "(" if open_low else "["
+        hi = ")" if open_high else "]"
+        raise ValueError(f"{name} must be in {lo}0, 1{hi}, got {value!r}")
+    return v
+
+
+# --------------------------------------------------------------------------- arrays
+
+
+def vectors(a, name: str, *, width: int | None = 3, ndim: int | None = 2,
+            allow_nan: bool = False, min_length: int = 0) -> np.ndarray:
+    """A float copy of ``a`` checked for shape and finiteness.
+
+    Parameters
+    ----------
+    a : array_like
+        The data.
+    name : str
+        Its name, used in error messages.
+    width : int, optional
+        Required size of the last dimension (``None``: any).
+    ndim : int, optional
+        Required number of dimensions (``None``: any).
+    allow_nan : bool
+        Accept NaN (never ±inf).
+    min_length : int
+        Minimum size of the first dimension.
+    """
+    try:
+        x = np.array(a, dtype=float)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be numeric, got {type(a).__name__}") from None
+    if ndim is not None and x.ndim != ndim:
+        shape = "(N, {})".format(width) if (ndim == 2 and width) else f"{ndim}-D"
+        raise ValueError(f"{name} must have shape {shape}, got {x.shape}")
+    if width is not None and (x.ndim == 0 or x.shape[-1] != width):
+        raise ValueError(f"{name} must have a last dimension of size {width}, got shape {x.shape}")
+    if x.ndim and x.shape[0] < min_length:
+        raise ValueError(f"{name} needs at least {min_length} samples, got {x.shape[0]}")
+    bad = ~np.isfinite(x) if not allow_nan else np.isinf(x)
+    if bad.any():
+        what = "non-finite" if not allow_nan else "infinite"
+        raise ValueError(f"{name} has {int(bad.sum())} {what} values")
+    return x
+
+
+@dataclass(frozen=True)
+class Signal:
+    """Values of one input with the metadata read from it.
+
+    ``values`` is a new array (never a view of the caller's data); ``fs`` (Hz), ``units``
+    and ``time`` (s) are ``None`` where unknown; ``coords`` holds the ``time`` coordinate
+    of a labelled input (to label the output); ``attrs`` its attributes.
+    """
+
+    values: np.ndarray
+    fs: float | None
+    units: str | None
+    time: np.ndarray | None = None
+    labelled: bool = False
+    attrs: dict[str, Any] = field(default_factory=dict)
+
+
+def _time_fs_check(time: np.ndarray, fs: float, where: str) -> None:
+    if time.size < 3:
+        return
+    dt = np.diff(time)
+    med = float(np.median(dt))
+    if not np.isfinite(med) or med <= 0:
+        raise RecordingError(f"{where}: the time coordinate is not increasing")
+    if abs(med * fs - 1.0) > 0.01:
+        raise RecordingError(
+            f"{where}: attribute fs = {fs:g} Hz contradicts the time coordinate "
+            f"(median step {med:.6g} s, i.e. {1.0 / med:.6g} Hz)"
+        )
+
+
+def signal(
+    data,
+    name: str,
+    *,
+    var: str | None = None,
+    fs=None,
+    units: str | None = None,
+    to_units: str | None = None,
+    need_fs: bool = True,
+    need_units: bool = False,
+    width: int | None = 3,
+    ndim: int | None = 2,
+    allow_nan: bool = False,
+) -> Signal:
+    """Read one input from a Recording, a labelled DataArray or a plain array.
+
+    Parameters
+    ----------
+    data : xarray.Dataset, xarray.DataArray or array_like
+        The input.
+    name : str
+        Its argument name, used in messages (and the variable read from a Recording unless
+        ``var`` is given).
+    var : str, optional
+        Variable to read from a Recording (default ``name``).
+    fs : float, optional
+        Sampling rate (Hz) for a plain array; for labelled input it must agree with
+        ``attrs["fs"]``.
+    units : str, optional
+        Units of a plain array; for labelled input it must agree with ``attrs["units"]``.
+    to_units : str, optional
+        Convert the values to these units (the input's units are then required).
+    need_fs, need_units : bool
+        Raise when the sampling rate / units cannot be determined.
+    width, ndim : int, optional
+        Shape requirements (see :func:`vectors`).
+    allow_nan : bool
+        Accept NaN values.
+
+    Returns
+    -------
+    Signal
+    """
+    attrs: dict[str, Any] = {}
+    time = None
+    labelled = False
+    where = name
+    if isinstance(data, xr.Dataset):
+        key = var or name
+        if key not in data:
+            raise RecordingError(f"the Recording has no variable {key!r} (needed for {name})")
+        da = data[key]
+        attrs = dict(data.attrs)
+        own_fs = data.attrs.get("fs")
+        own_units = da.attrs.get("units")
+        where = f"Recording variable {key!r}"
+        labelled = True
+    elif isinstance(data, xr.DataArray):
+        da = data
+        attrs = dict(da.attrs)
+        own_fs = da.attrs.get("fs")
+        own_units = da.attrs.get("units")
+        labelled = True
+    else:
+        da = None
+        own_fs = None
+        own_units = None
+    if labelled:
+        values = np.array(da.values, dtype=float)
+        if "time" in da.coords and da.coords["time"].ndim == 1:
+            time = np.asarray(da.coords["time"].values, dtype=float)
+        values = vectors(values, name, width=width, ndim=ndim, allow_nan=allow_nan)
+    else:
+        values = vectors(data, name, width=width, ndim=ndim, allow_nan=allow_nan)
+
+    # sampling rate: attrs and argument must agree
+    f = None
+    if own_fs is not None:
+        f = check_fs(own_fs, name=f"{where} attribute fs")
+        if fs is not None and not np.isclose(check_fs(fs), f, rtol=1e-9, atol=0.0):
+            raise RecordingError(f"{name}: fs = {fs!r} contradicts the data's attribute fs = {f:g} Hz")
+    elif fs is not None:
+        f = check_fs(fs)
+    elif need_fs:
+        hint = "add attrs['fs'] to it" if labelled else "pass fs="
+        raise RecordingError(
+            f"{name}: the sampling rate fs is unknown ({hint}); tiltlab never assumes a default"
+        )
+    if f is not None and time is not None:
+        _time_fs_check(time, f, where)
+
+    # units: attrs and argument must agree
+    u = None
+    if own_units is not None:
+        u = _units.normalise_unit(own_units)
+        if units is not None and _units.normalise_unit(units) != u:
+            raise RecordingError(f"{name}: units = {units!r} contradicts the data's units {own_units!r}")
+    elif units is not None:
+        u = _units.normalise_unit(units)
+    if u is None and (need_units or to_units is not None):
+        hint = "add attrs['units'] to it" if labelled else "pass units="
+        raise RecordingError(f"{name}: its units are unknown ({hint})")
+    if to_units is not None:
+        values = values * _units.conversion_factor(u, to_units)
+        u = _units.normalise_unit(to_units)
+    return Signal(values, f, u, time, labelled, attrs)
+
+
+def labelled(values, like: Signal, name: str, *, units: str | None = None,
+             dims: tuple[str, ...] | None = None, coords: dict | None = None,
+             attrs: dict[str, Any] | None = None):
+    """Wrap a per-sample result as a DataArray when its input was labelled, else return it.
+
+    The output keeps the input's ``time`` coordinate and ``fs``; ``units`` and ``attrs``
+    are added. Plain-array inputs give plain arrays back.
+    """
+    if not like.labelled:
+        return values
+    values = np.asarray(values)
+    if dims is None:
+        dims = ("time",) + tuple(f"dim_{k}" for k in range(1, values.ndim))
+        if values.ndim == 2 and values.shape[1] == 3:
+            dims = ("time", "axis")
+    c = {}
+    if like.time is not None and "time" in dims and values.shape[dims.index("time")] == like.time.size:
+        c["time"] = like.time
+    if "axis" in dims:
+        c["axis"] = ["x", "y", "z"]
+    if coords:
+        c.update(coords)
+    a: dict[str, Any] = {}
+    if like.fs is not None:
+        a["fs"] = like.fs
+    if units is not None:
+        a["units"] = units
+    if attrs:
+        a.update(attrs)
+    return xr.DataArray(values, dims=dims, coords=c, name=name, attrs=a)
+
+
+# imported last: tiltlab.units re-exports check_fs from this module
+from . import units as _units  # noqa: E402

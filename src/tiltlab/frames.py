@@ -1,0 +1,414 @@
+r"""Named frames and their geometry, in one place.
+
+Layer 3 of the package (beside :mod:`tiltlab.quaternion`): the conventions that several
+modules share and that must not be implemented twice.
+
+* **Sensor frame** — the IMU's own axes; tiltlab's quaternions rotate sensor → world
+  (world z up), and tilt is the gravity-up direction in the sensor frame.
+* **Benhamou body frame** — surge, sway, heave (forward, left, up) in an ENU world
+  (Benhamou 2023 [1]_ §1): rotation matrices :func:`R1`, :func:`R2` (clockwise, so that a
+  positive elevation is nose up), :func:`R3`; the orientation matrix
+  :math:`C = R_3(\theta) R_2(\phi) R_1(\lambda)` (:func:`angles_to_matrix`); the sign
+  conventions between tiltlab's specific force and Benhamou's acceleration
+  (:func:`to_benhamou_acc`) and between the gyroscope and Benhamou's roll/pitch/yaw speeds
+  (:func:`gyro_to_body_rates`); the device → body mounting correction (Eq. 1, App. A:
+  :func:`mounting_angles`, :func:`mounting_matrix`, :func:`device_to_body`).
+* **Tumble stage** — the two-axis (pitch, roll) stage of Fayat et al. [2]_ App. A.1:
+  :func:`stage_angles`, :func:`stage_quaternion`, and the spherical Fibonacci lattice of
+  target orientations (:func:`fibonacci_lattice`).
+* **Marker head frame** — the head frame defined by three motion-capture markers
+  (Fayat §2.6.4, :func:`head_frame_from_markers`).
+
+References
+----------
+.. [1] S. Benhamou, "Inferring the 3D orientation of a body from its acceleration and
+   magnetic field", Movement Ecology (2023).
+.. [2] R. Fayat et al., Sensors 21(18):6318, 2021. doi:10.3390/s21186318
+.. [3] R. Swinbank and R. J. Purser, "Fibonacci grids: A novel approach to global
+   modelling", Q. J. R. Meteorol. Soc. 132:1769–1793, 2006. doi:10.1256/qj.05.235
+"""
+
+from __future__ import annotations
+
+from typing import Literal, NamedTuple
+
+import numpy as np
+
+from . import quaternion as _quat
+
+__all__ = [
+    "Convention",
+    "Orientation",
+    "wrap_angle",
+    "R1",
+    "R2",
+    "R3",
+    "unit_vector",
+    "spherical_coords",
+    "to_benhamou_acc",
+    "from_benhamou_acc",
+    "gyro_to_body_rates",
+    "body_rates_to_gyro",
+    "angles_to_matrix",
+    "angles_from_matrix",
+    "angles_to_quaternion",
+    "angles_from_quaternion",
+    "acc_from_angles",
+    "geomagnetic_field",
+    "mag_from_angles",
+    "mounting_angles",
+    "mounting_matrix",
+    "device_to_body",
+    "device_to_body_eq1",
+    "fibonacci_lattice",
+    "stage_angles",
+    "stage_quaternion",
+    "head_frame_from_markers",
+]
+
+Convention = Literal["tiltlab", "benhamou"]
+_GOLDEN = (1.0 + 5.0**0.5) / 2.0
+
+class Orientation(NamedTuple):
+    """Azimuth θ, elevation φ and bank λ (rad)."""
+
+    azimuth: np.ndarray
+    elevation: np.ndarray
+    bank: np.ndarray
+
+
+
+def _vec3(a, name: str) -> np.ndarray:
+    a = np.asarray(a, dtype=float)
+    if a.ndim == 0 or a.shape[-1] != 3:
+        raise ValueError(f"{name} must have a last dimension of size 3, got shape {a.shape}")
+    return a
+
+
+def _as_benhamou(acc, convention: Convention, name: str = "acc") -> np.ndarray:
+    acc = _vec3(acc, name)
+    if convention == "tiltlab":
+        return -acc
+    if convention == "benhamou":
+        return acc.copy()
+    raise ValueError(f"convention must be 'tiltlab' or 'benhamou', got {convention!r}")
+
+
+def _clip1(x):
+    return np.clip(x, -1.0, 1.0)
+
+
+def wrap_angle(angle) -> np.ndarray:
+    """Wrap angles (rad) to (−π, π]."""
+    a = np.asarray(angle, dtype=float)
+    w = np.mod(a + np.pi, 2 * np.pi) - np.pi
+    return np.where(w == -np.pi, np.pi, w)
+
+
+
+# ---------------------------------------------------------------------------
+# Benhamou's notation and the body frame (§1)
+# ---------------------------------------------------------------------------
+
+
+
+def _rot(angle, i: int, j: int, sign: float) -> np.ndarray:
+    a = np.asarray(angle, dtype=float)
+    c, s = np.cos(a), np.sin(a)
+    m = np.zeros(a.shape + (3, 3))
+    k = 3 - i - j
+    m[..., k, k] = 1.0
+    m[..., i, i] = c
+    m[..., j, j] = c
+    m[..., i, j] = -sign * s
+    m[..., j, i] = sign * s
+    return m
+
+
+def R1(angle) -> np.ndarray:
+    r"""Benhamou's rotation about the first axis (X or U), counter-clockwise: shape (..., 3, 3).
+
+    :math:`R_1(\varphi) = \begin{pmatrix}1&0&0\\0&\cos\varphi&-\sin\varphi\\0&\sin\varphi&\cos\varphi\end{pmatrix}`.
+    """
+    return _rot(angle, 1, 2, 1.0)
+
+
+def R2(angle) -> np.ndarray:
+    r"""Benhamou's rotation about the second axis (Y or V), measured *clockwise*: shape (..., 3, 3).
+
+    :math:`R_2(\varphi) = \begin{pmatrix}\cos\varphi&0&-\sin\varphi\\0&1&0\\\sin\varphi&0&\cos\varphi\end{pmatrix}`,
+    i.e. the usual right-handed :math:`R_y(-\varphi)`, so that a positive angle raises
+    the first axis (positive elevation = nose up).
+    """
+    return _rot(angle, 0, 2, 1.0)
+
+
+def R3(angle) -> np.ndarray:
+    r"""Benhamou's rotation about the third axis (Z or W), counter-clockwise: shape (..., 3, 3)."""
+    return _rot(angle, 0, 1, 1.0)
+
+
+def unit_vector(xi, psi) -> np.ndarray:
+    r"""Benhamou's :math:`[\xi\bullet\psi] = (\cos\xi\cos\psi, \sin\xi\cos\psi, \sin\psi)`, shape (..., 3)."""
+    xi, psi = np.broadcast_arrays(np.asarray(xi, float), np.asarray(psi, float))
+    return np.stack([np.cos(xi) * np.cos(psi), np.sin(xi) * np.cos(psi), np.sin(psi)], axis=-1)
+
+
+def spherical_coords(v) -> tuple[np.ndarray, np.ndarray]:
+    r"""Inverse of :func:`unit_vector`: (ξ, ψ) of (not necessarily unit) vectors.
+
+    ψ is computed as :math:`\mathrm{atan2}(v_z, \sqrt{v_x^2+v_y^2})` (accurate near ±π/2);
+    ξ = atan2(v_y, v_x) is 0 on the poles (documented fallback).
+    """
+    v = _vec3(v, "v")
+    return np.arctan2(v[..., 1], v[..., 0]), np.arctan2(v[..., 2], np.hypot(v[..., 0], v[..., 1]))
+
+
+def to_benhamou_acc(acc) -> np.ndarray:
+    """Specific force (tiltlab, +1 g on the up axis) → Benhamou's acceleration sign (−g on the up axis)."""
+    return -_vec3(acc, "acc")
+
+
+def from_benhamou_acc(acc) -> np.ndarray:
+    """Benhamou's acceleration sign (−g on the up axis) → specific force (tiltlab)."""
+    return -_vec3(acc, "acc")
+
+
+def gyro_to_body_rates(gyr) -> np.ndarray:
+    r"""tiltlab angular velocity (ω_x, ω_y, ω_z) → Benhamou's (roll, pitch, yaw) speeds (ρ̇, β̇, α̇).
+
+    :math:`\dot\rho=\omega_x`, :math:`\dot\beta=-\omega_y` (positive nose-up),
+    :math:`\dot\alpha=\omega_z`. Units are kept (pass rad/s for radians).
+    """
+    g = _vec3(gyr, "gyr")
+    return np.stack([g[..., 0], -g[..., 1], g[..., 2]], axis=-1)
+
+
+def body_rates_to_gyro(rates) -> np.ndarray:
+    """Inverse of :func:`gyro_to_body_rates`: (ρ̇, β̇, α̇) → (ω_x, ω_y, ω_z)."""
+    return gyro_to_body_rates(rates)
+
+
+def angles_to_matrix(azimuth, elevation, bank) -> np.ndarray:
+    r"""Body→world (ENU) rotation matrices :math:`C = R_3(\theta)R_2(\phi)R_1(\lambda)`, shape (..., 3, 3).
+
+    Column k is body axis k (surge, sway, heave) in world coordinates; column 0 is
+    :math:`[\theta\bullet\phi]`.
+    """
+    return R3(azimuth) @ R2(elevation) @ R1(bank)
+
+
+def angles_from_matrix(matrix, singular_tol: float = 1e-9) -> Orientation:
+    r"""Azimuth, elevation and bank from body→world rotation matrices.
+
+    :math:`\theta=\mathrm{atan2}(C_{10},C_{00})`, :math:`\phi=\mathrm{atan2}(C_{20},\sqrt{C_{00}^2+C_{10}^2})`,
+    :math:`\lambda=\mathrm{atan2}(C_{21},C_{22})`.
+
+    Singular configuration (surge vertical, :math:`\cos\phi <` ``singular_tol``):
+    θ and λ are then not separately defined; following Benhamou (§3, App. B) the
+    pseudo-bank is λ = 0 and the pseudo-azimuth θ = θ' − π/2 with θ' the azimuth of
+    the sway axis, which represents the same rotation exactly.
+    """
+    C = np.asarray(matrix, dtype=float)
+    if C.shape[-2:] != (3, 3):
+        raise ValueError(f"matrix must have shape (..., 3, 3), got {C.shape}")
+    h = np.hypot(C[..., 0, 0], C[..., 1, 0])
+    el = np.arctan2(C[..., 2, 0], h)
+    az = np.arctan2(C[..., 1, 0], C[..., 0, 0])
+    bk = np.arctan2(C[..., 2, 1], C[..., 2, 2])
+    sing = h < singular_tol
+    az = np.where(sing, wrap_angle(np.arctan2(C[..., 1, 1], C[..., 0, 1]) - np.pi / 2), az)
+    bk = np.where(sing, 0.0, bk)
+    return Orientation(az, el, bk)
+
+
+def angles_to_quaternion(azimuth, elevation, bank) -> np.ndarray:
+    r"""Sensor(body)→world quaternions (w, x, y, z) of :math:`R_3(\theta)R_2(\phi)R_1(\lambda)`, w ≥ 0.
+
+    Closed form :math:`q = q_z(\theta)\otimes q_y(-\phi)\otimes q_x(\lambda)`.
+    """
+    t, p, lam = np.broadcast_arrays(*(np.asarray(a, float) / 2 for a in (azimuth, elevation, bank)))
+    ct, st = np.cos(t), np.sin(t)
+    cp, sp = np.cos(p), -np.sin(p)  # rotation by -phi about y
+    cl, sl = np.cos(lam), np.sin(lam)
+    w = ct * cp * cl + st * sp * sl
+    x = ct * cp * sl - st * sp * cl
+    y = ct * sp * cl + st * cp * sl
+    z = st * cp * cl - ct * sp * sl
+    q = np.stack([w, x, y, z], axis=-1)
+    return np.where(q[..., :1] < 0, -q, q)
+
+
+def angles_from_quaternion(q, singular_tol: float = 1e-9) -> Orientation:
+    """Azimuth, elevation, bank of sensor(body)→world quaternions (see :func:`angles_from_matrix`)."""
+    q = np.asarray(q, dtype=float)
+    if q.ndim == 0 or q.shape[-1] != 4:
+        raise ValueError(f"q must have a last dimension of size 4, got {q.shape}")
+    return angles_from_matrix(_quat.to_matrix(q), singular_tol=singular_tol)
+
+
+def acc_from_angles(elevation, bank, g: float = 1.0, convention: Convention = "tiltlab") -> np.ndarray:
+    r"""Static accelerometer reading of a body at rest with elevation φ and bank λ, shape (..., 3).
+
+    Specific force (``"tiltlab"``): :math:`g\,C^\top e_z = g(\sin\phi, \cos\phi\sin\lambda, \cos\phi\cos\lambda)`;
+    ``"benhamou"`` returns its negative.
+    """
+    p, lam = np.broadcast_arrays(np.asarray(elevation, float), np.asarray(bank, float))
+    f = g * np.stack([np.sin(p), np.cos(p) * np.sin(lam), np.cos(p) * np.cos(lam)], axis=-1)
+    return f if convention == "tiltlab" else _as_benhamou(f, "tiltlab")
+
+
+def geomagnetic_field(intensity: float = 48.0, inclination: float = np.radians(64.0), declination: float = 0.0) -> np.ndarray:
+    r"""Geomagnetic field in ENU coordinates.
+
+    ``inclination`` is the dip angle, positive *downwards* (northern hemisphere),
+    ``declination`` is positive East of true North:
+    :math:`B(\cos I\sin D, \cos I\cos D, -\sin I)`.
+    """
+    return intensity * np.array(
+        [np.cos(inclination) * np.sin(declination), np.cos(inclination) * np.cos(declination), -np.sin(inclination)]
+    )
+
+
+def mag_from_angles(azimuth, elevation, bank, field=None) -> np.ndarray:
+    """Magnetometer reading (field in body axes, :math:`C^T m_{ENU}`) for orientations θ, φ, λ, shape (..., 3)."""
+    m = geomagnetic_field() if field is None else _vec3(field, "field")
+    C = angles_to_matrix(azimuth, elevation, bank)
+    return np.einsum("...ji,j->...i", C, m)
+
+
+
+
+# ---------------------------------------------------------------------------
+# device -> body (Eq. 1, App. A)
+# ---------------------------------------------------------------------------
+
+
+def mounting_angles(acc_rest, convention: Convention = "tiltlab") -> tuple[np.ndarray, np.ndarray]:
+    r"""Device mounting angles φ*, λ* from the acceleration recorded with the animal at rest and level.
+
+    :math:`\phi^*=\sin^{-1}(-a^*_U/\|\mathbf a^*\|)`, :math:`\lambda^*=\mathrm{atan2}(-a^*_V,-a^*_W)` (§1),
+    with Benhamou's sign (converted from ``convention``). ``acc_rest`` may be a
+    single vector or many (then average them first for a single mounting).
+    """
+    return _elev_bank(_as_benhamou(acc_rest, convention, "acc_rest"))
+
+
+def _elev_bank(A):
+    el = np.arctan2(-A[..., 0], np.hypot(A[..., 1], A[..., 2]))
+    bk = np.arctan2(-A[..., 1], -A[..., 2])
+    return el, bk
+
+
+
+def mounting_matrix(phi_star, lambda_star, dtheta=0.0) -> np.ndarray:
+    r"""Device→body matrix :math:`R_3(\Delta\theta)R_2(\phi^*)R_1(\lambda^*)` (App. A; Δθ = 0 gives Eq. 1)."""
+    return R3(dtheta) @ R2(phi_star) @ R1(lambda_star)
+
+
+def device_to_body(vectors, phi_star, lambda_star, dtheta=0.0, rates: bool = False) -> np.ndarray:
+    r"""Express device-frame vectors in the body frame: :math:`\mathbf B^\top = R_3(\Delta\theta)R_2(\phi^*)R_1(\lambda^*)\mathbf D^\top`.
+
+    Applies to (static) acceleration in either sign convention, calibrated magnetic
+    field, and tiltlab gyroscope vectors ω, which are ordinary vectors. If
+    ``rates=True`` the columns are Benhamou's (ρ̇, β̇, α̇); the pitch-rate sign is
+    flipped before and after the rotation (App. A: :math:`B_V=-\dot\beta`, :math:`D_V=-\dot\beta^d`).
+    """
+    D = _vec3(vectors, "vectors")
+    if rates:
+        D = gyro_to_body_rates(D)
+    M = mounting_matrix(phi_star, lambda_star, dtheta)
+    B = np.einsum("...ij,...j->...i", M, D)
+    return gyro_to_body_rates(B) if rates else B
+
+
+def device_to_body_eq1(vectors, acc_rest, convention: Convention = "tiltlab") -> np.ndarray:
+    r"""Eq. 1a–1c: explicit (matrix-free) device→body correction from the level-rest acceleration a*.
+
+    .. math::
+        B_U &= \big(D_U\,s - a^*_U (D_V a^*_V + D_W a^*_W)/s\big)/\|\mathbf a^*\|,\quad s=(a^{*2}_V+a^{*2}_W)^{1/2}\\
+        B_V &= (D_W a^*_V - D_V a^*_W)/s\\
+        B_W &= -(D_U a^*_U + D_V a^*_V + D_W a^*_W)/\|\mathbf a^*\|
+
+    with a* in Benhamou's sign (converted from ``convention``). Identical to
+    :func:`device_to_body` with :func:`mounting_angles`. Requires s > 0 (device not
+    mounted vertically).
+    """
+    D = _vec3(vectors, "vectors")
+    a = _as_benhamou(acc_rest, convention, "acc_rest")
+    aU, aV, aW = a[..., 0], a[..., 1], a[..., 2]
+    s = np.hypot(aV, aW)
+    if np.any(s == 0):
+        raise ValueError("acc_rest has no sway/heave component: the mounting bank angle is undefined")
+    n = np.sqrt(aU**2 + s**2)
+    DU, DV, DW = D[..., 0], D[..., 1], D[..., 2]
+    BU = (DU * s - aU * (DV * aV + DW * aW) / s) / n
+    BV = (DW * aV - DV * aW) / s
+    BW = -(DU * aU + DV * aV + DW * aW) / n
+    return np.stack(np.broadcast_arrays(BU, BV, BW), axis=-1)
+
+
+# ---------------------------------------------------------------------------
+# tumble stage and the Fibonacci lattice (Fayat App. A.1)
+# ---------------------------------------------------------------------------
+
+
+def fibonacci_lattice(n: int = 5000) -> np.ndarray:
+    r"""Spherical Fibonacci lattice of ``n`` nearly uniform unit vectors, shape (n, 3).
+
+    Point :math:`i = 0,\dots,n-1` has :math:`z_i = 1 - (2i+1)/n` (equal-area latitude
+    bands) and longitude :math:`2\pi i/\Phi` with the golden ratio :math:`\Phi` [3]_.
+    """
+    if isinstance(n, bool) or int(n) != n or n < 1:
+        raise ValueError(f"n must be a positive integer, got {n!r}")
+    i = np.arange(int(n), dtype=float)
+    z = 1.0 - (2.0 * i + 1.0) / n
+    r = np.sqrt(np.clip(1.0 - z * z, 0.0, None))
+    lon = 2.0 * np.pi * ((i / _GOLDEN) % 1.0)
+    return np.column_stack([r * np.cos(lon), r * np.sin(lon), z])
+
+
+def stage_angles(g) -> tuple[np.ndarray, np.ndarray]:
+    r"""Stage pitch β and roll γ (rad) bringing gravity-up to ``g`` in the sensor frame.
+
+    With the stage :math:`R = R_y(\beta) R_x(\gamma)`, the tilt is
+    :math:`g = R^\top e_z = (-\sin\beta, \sin\gamma\cos\beta, \cos\gamma\cos\beta)`,
+    so :math:`\beta = -\arcsin g_x` and :math:`\gamma = \operatorname{atan2}(g_y, g_z)`.
+    """
+    g = np.asarray(g, float)
+    if g.shape[-1] != 3:
+        raise ValueError(f"g must have last dimension 3, got {g.shape}")
+    g = g / np.linalg.norm(g, axis=-1, keepdims=True)
+    # atan2 form of beta = -asin(g_x): accurate near the poles too
+    return np.arctan2(-g[..., 0], np.hypot(g[..., 1], g[..., 2])), np.arctan2(g[..., 1], g[..., 2])
+
+
+def stage_quaternion(pitch, roll) -> np.ndarray:
+    """Orientation ``R_y(pitch) R_x(roll)`` (sensor → world) of the two-axis stage."""
+    pitch, roll = np.broadcast_arrays(np.asarray(pitch, float), np.asarray(roll, float))
+    z = np.zeros_like(pitch)
+    return _quat.mul(
+        _quat.from_rotvec(np.stack([z, pitch, z], -1)),
+        _quat.from_rotvec(np.stack([roll, z, z], -1)),
+    )
+
+
+# ---------------------------------------------------------------------------
+# marker head frame (Fayat §2.6.4)
+# ---------------------------------------------------------------------------
+
+
+def head_frame_from_markers(m1, m2, m3) -> np.ndarray:
+    r"""Head frame of Fayat §2.6.4 from markers 1–3: rotation matrices (..., 3, 3) whose
+    columns are :math:`h_x, h_y, h_z` in mocap (world) coordinates.
+
+    :math:`h_y = (m_1 - m_2)/\|\cdot\|`, :math:`h_z = (m_3 - m_2) \times h_y / \|\cdot\|`,
+    :math:`h_x = h_y \times h_z`.
+    """
+    m1, m2, m3 = (np.asarray(v, float) for v in (m1, m2, m3))
+    hy = m1 - m2
+    hy = hy / np.linalg.norm(hy, axis=-1, keepdims=True)
+    hz = np.cross(m3 - m2, hy)
+    hz = hz / np.linalg.norm(hz, axis=-1, keepdims=True)
+    hx = np.cross(hy, hz)
+    return np.stack([hx, hy, hz], axis=-1)
