@@ -8,7 +8,7 @@ STAMP := $(VENV)/.tiltlab-installed
 MATHJAX_VERSION ?= 3.2.2
 MATHJAX_DIR := book/_vendor/mathjax
 
-.PHONY: env book test browser-test benchmarks registry clean
+.PHONY: env book test lint rerun browser-test benchmarks registry clean
 
 env: $(STAMP)
 
@@ -27,8 +27,18 @@ book: env $(MATHJAX_DIR)/tex-chtml.js
 	rm -rf book/_build
 	$(VENV)/bin/jupyter-book build book --all -W -n --keep-going
 
-test: env
+# style and layer contracts (ruff on code and notebooks; import-linter on the package)
+lint: env
+	$(VENV)/bin/ruff check src tests benchmarks tools notebooks
+	$(VENV)/bin/ruff format --check src tests benchmarks tools notebooks
+	$(VENV)/bin/lint-imports
+
+test: lint
 	$(PY) -m pytest
+
+# every chapter a second time on another data source / parameter set (papermill)
+rerun: env
+	$(PY) tools/rerun_chapters.py
 
 browser-test: env
 	TILTLAB_REQUIRE_BOOK=1 $(PY) -m pytest -m browser

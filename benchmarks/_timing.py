@@ -1,4 +1,5 @@
 """Timing helper shared by the benchmark scripts (run as ``python benchmarks/bench_*.py``)."""
+
 import time
 
 

@@ -15,6 +15,7 @@ import warnings
 
 import numpy as np
 
+from tiltlab import evaluate as E
 from tiltlab import filters as F
 from tiltlab import quaternion as Q
 from tiltlab.schema import make_recording
@@ -24,7 +25,9 @@ from _timing import best_of
 def synthetic(n: int, fs: float = 200.0, seed: int = 0):
     rng = np.random.default_rng(seed)
     t = np.arange(n) / fs
-    omega = np.column_stack([1.5 * np.sin(0.7 * t), np.cos(0.4 * t + 1.0), 0.8 * np.sin(0.9 * t + 2.0)])
+    omega = np.column_stack(
+        [1.5 * np.sin(0.7 * t), np.cos(0.4 * t + 1.0), 0.8 * np.sin(0.9 * t + 2.0)]
+    )
     q = Q.integrate_gyro(np.vstack([omega[1:], omega[-1:]]), fs, Q.identity())
     acc = 9.81 * Q.gravity(q) + 0.3 * rng.standard_normal((n, 3))
     mag = Q.rotate_inverse(q, [0.0, 20.0, -40.0]) + 0.5 * rng.standard_normal((n, 3))
@@ -34,17 +37,33 @@ def synthetic(n: int, fs: float = 200.0, seed: int = 0):
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--n", type=int, default=1_000_000, help="samples for tiltlab kernels")
-    ap.add_argument("--n-ref", type=int, default=20_000, help="samples for the (slow) ahrs reference")
-    ap.add_argument("--grid", type=int, default=30, help="number of gain values in the grid")
-    ap.add_argument("--n-offline", type=int, default=100_000, help="samples for the offline smoothers")
+    ap.add_argument(
+        "--n", type=int, default=1_000_000, help="samples for tiltlab kernels"
+    )
+    ap.add_argument(
+        "--n-ref",
+        type=int,
+        default=20_000,
+        help="samples for the (slow) ahrs reference",
+    )
+    ap.add_argument(
+        "--grid", type=int, default=30, help="number of gain values in the grid"
+    )
+    ap.add_argument(
+        "--n-offline",
+        type=int,
+        default=100_000,
+        help="samples for the offline smoothers",
+    )
     args = ap.parse_args()
     n, n_ref = args.n, args.n_ref
 
     acc, gyr, mag, q_true, fs = synthetic(n)
     a_r, g_r, m_r = acc[:n_ref], gyr[:n_ref], mag[:n_ref]
     q0 = q_true[0]
-    print(f"tiltlab.filters benchmark: N = {n:,} samples (ahrs: {n_ref:,}), {os.cpu_count()} CPU cores")
+    print(
+        f"tiltlab.filters benchmark: N = {n:,} samples (ahrs: {n_ref:,}), {os.cpu_count()} CPU cores"
+    )
 
     # warm-up (numba compile / cache load)
     for fn in (F.madgwick, F.mahony, F.ekf, F.complementary):
@@ -58,20 +77,50 @@ def main() -> None:
 
     rows = []
     cases = [
-        ("madgwick 6D", lambda a, g, m: F.madgwick(a, g, fs, beta=0.05, q0=q0),
-         lambda a, g, m: ahrs_filters.Madgwick(gyr=g, acc=a, frequency=fs, gain=0.05, q0=q0)),
-        ("madgwick 9D", lambda a, g, m: F.madgwick(a, g, fs, mag=m, beta=0.05, q0=q0),
-         lambda a, g, m: ahrs_filters.Madgwick(gyr=g, acc=a, mag=m, frequency=fs, gain=0.05)),
-        ("mahony 6D", lambda a, g, m: F.mahony(a, g, fs, q0=q0),
-         lambda a, g, m: ahrs_filters.Mahony(gyr=g, acc=a, frequency=fs, q0=q0)),
-        ("ekf 6D", lambda a, g, m: F.ekf(a, g, fs, q0=q0),
-         lambda a, g, m: ahrs_filters.EKF(gyr=g, acc=a, frequency=fs, frame="NED", q0=q0)),
-        ("ekf 9D", lambda a, g, m: F.ekf(a, g, fs, mag=m, dip=63.4, q0=q0),
-         lambda a, g, m: ahrs_filters.EKF(gyr=g, acc=a, mag=m, frequency=fs, frame="NED", q0=q0,
-                                          magnetic_ref=np.array([0.0, 0.447, -0.894]))),
+        (
+            "madgwick 6D",
+            lambda a, g, m: F.madgwick(a, g, fs, beta=0.05, q0=q0),
+            lambda a, g, m: ahrs_filters.Madgwick(
+                gyr=g, acc=a, frequency=fs, gain=0.05, q0=q0
+            ),
+        ),
+        (
+            "madgwick 9D",
+            lambda a, g, m: F.madgwick(a, g, fs, mag=m, beta=0.05, q0=q0),
+            lambda a, g, m: ahrs_filters.Madgwick(
+                gyr=g, acc=a, mag=m, frequency=fs, gain=0.05
+            ),
+        ),
+        (
+            "mahony 6D",
+            lambda a, g, m: F.mahony(a, g, fs, q0=q0),
+            lambda a, g, m: ahrs_filters.Mahony(gyr=g, acc=a, frequency=fs, q0=q0),
+        ),
+        (
+            "ekf 6D",
+            lambda a, g, m: F.ekf(a, g, fs, q0=q0),
+            lambda a, g, m: ahrs_filters.EKF(
+                gyr=g, acc=a, frequency=fs, frame="NED", q0=q0
+            ),
+        ),
+        (
+            "ekf 9D",
+            lambda a, g, m: F.ekf(a, g, fs, mag=m, dip=63.4, q0=q0),
+            lambda a, g, m: ahrs_filters.EKF(
+                gyr=g,
+                acc=a,
+                mag=m,
+                frequency=fs,
+                frame="NED",
+                q0=q0,
+                magnetic_ref=np.array([0.0, 0.447, -0.894]),
+            ),
+        ),
         ("complementary 6D", lambda a, g, m: F.complementary(a, g, fs, q0=q0), None),
     ]
-    print(f"\n{'method':18s} {'tiltlab (M samples/s)':>22s} {'ahrs (k samples/s)':>19s} {'ratio':>8s}")
+    print(
+        f"\n{'method':18s} {'tiltlab (M samples/s)':>22s} {'ahrs (k samples/s)':>19s} {'ratio':>8s}"
+    )
     for name, ours, ref in cases:
         t_ours = best_of(lambda: ours(acc, gyr, mag))
         r_ours = n / t_ours
@@ -81,7 +130,9 @@ def main() -> None:
                 warnings.simplefilter("ignore")
                 t_ref = best_of(lambda: ref(a_r[:nr], g_r[:nr], m_r[:nr]), repeat=1)
             r_ref = nr / t_ref
-            print(f"{name:18s} {r_ours / 1e6:22.2f} {r_ref / 1e3:19.2f} {r_ours / r_ref:8.0f}x")
+            print(
+                f"{name:18s} {r_ours / 1e6:22.2f} {r_ref / 1e3:19.2f} {r_ours / r_ref:8.0f}x"
+            )
         else:
             print(f"{name:18s} {r_ours / 1e6:22.2f} {'-':>19s} {'-':>8s}")
         rows.append((name, r_ours))
@@ -91,43 +142,64 @@ def main() -> None:
     no = min(n, args.n_offline)
     a_o, g_o = acc[:no], gyr[:no]
     F.rts_smoother(a_o[:200], g_o[:200], fs)  # warm-up
-    offline = [("rts_smoother 6D", lambda: F.rts_smoother(a_o, g_o, fs)),
-               ("rts forward only", lambda: F.rts_smoother(a_o, g_o, fs, smooth=False)),
-               ("smoother 6D", lambda: F.smoother(a_o, g_o, fs)),
-               ("offlineVQF 6D", lambda: F._vqf_run(a_o, g_o, None, fs, True, {}))]
+    offline = [
+        ("rts_smoother 6D", lambda: F.rts_smoother(a_o, g_o, fs)),
+        ("rts forward only", lambda: F.rts_smoother(a_o, g_o, fs, smooth=False)),
+        ("smoother 6D", lambda: F.smoother(a_o, g_o, fs)),
+        ("offlineVQF 6D", lambda: F.run_offline_vqf(a_o, g_o, fs)),
+    ]
     print(f"\noffline methods, N = {no:,} samples (samples/s):")
     r_off = {}
     for name, fn in offline:
         r_off[name] = no / best_of(fn, repeat=2)
         print(f"{name:18s} {r_off[name] / 1e6:10.3f} M/s")
-    print(f"rts_smoother / offlineVQF throughput ratio: {r_off['rts_smoother 6D'] / r_off['offlineVQF 6D']:.2f}")
+    print(
+        f"rts_smoother / offlineVQF throughput ratio: {r_off['rts_smoother 6D'] / r_off['offlineVQF 6D']:.2f}"
+    )
 
     # ---- gain grid: 30 values over N samples, 2 workers
     betas = np.geomspace(0.002, 0.5, args.grid)
-    rec = make_recording(acc, gyr, fs, acc_units="m/s^2", gyr_units="rad/s", q_ref=q_true,
-                         extra={"movement": (("time",), np.ones(n, bool), {})})
-    F.grid_search([rec], "madgwick", {"beta": betas[:2]}, n_jobs=2)  # warm-up
+    rec = make_recording(
+        acc,
+        gyr,
+        fs,
+        acc_units="m/s^2",
+        gyr_units="rad/s",
+        q_ref=q_true,
+        extra={"movement": (("time",), np.ones(n, bool), {})},
+    )
+    E.grid_search([rec], "madgwick", {"beta": betas[:2]}, n_jobs=2)  # warm-up
     t0 = time.perf_counter()
-    grid = F.grid_search([rec], "madgwick", {"beta": betas}, n_jobs=2)
+    grid = E.grid_search([rec], "madgwick", {"beta": betas}, n_jobs=2)
     t_grid = time.perf_counter() - t0
-    print(f"\ngrid_search: {args.grid} Madgwick gains x {n:,} samples (scored: tilt RMSE), 2 threads: {t_grid:.2f} s "
-          f"(best beta {float(grid.beta[int(grid.argmin('beta').item())]):.3g}, RMSE {float(grid.min()):.3f} deg)")
-    F.madgwick_batch(acc[:1000], gyr[:1000], fs, betas[:2], q0=q0)  # warm-up
+    print(
+        f"\ngrid_search: {args.grid} Madgwick gains x {n:,} samples (scored: tilt RMSE), 2 threads: {t_grid:.2f} s "
+        f"(best beta {float(grid.beta[int(grid.argmin('beta').item())]):.3g}, RMSE {float(grid.min()):.3f} deg)"
+    )
+    F.madgwick_batch(acc[:1000], gyr[:1000], fs, betas=betas[:2], q0=q0)  # warm-up
     import numba
 
     numba.set_num_threads(min(2, numba.config.NUMBA_NUM_THREADS))
     t0 = time.perf_counter()
-    F.madgwick_batch(acc, gyr, fs, betas, q0=q0)
+    F.madgwick_batch(acc, gyr, fs, betas=betas, q0=q0)
     t_batch = time.perf_counter() - t0
-    print(f"madgwick_batch (numba prange, 2 threads): {args.grid} gains x {n:,} samples: {t_batch:.2f} s")
+    print(
+        f"madgwick_batch (numba prange, 2 threads): {args.grid} gains x {n:,} samples: {t_batch:.2f} s"
+    )
 
     print("\ntargets:")
     mad = dict(rows)["madgwick 6D"]
     ekf = dict(rows)["ekf 6D"]
-    print(f"  Madgwick 6D >= 10 M samples/s: {mad / 1e6:.1f} M/s -> {'OK' if mad >= 1e7 else 'MISSED'}")
-    print(f"  EKF 6D >= 1 M samples/s: {ekf / 1e6:.2f} M/s -> {'OK' if ekf >= 1e6 else 'MISSED'}")
-    print(f"  30-gain grid over 1 M samples < 5 s: {t_grid:.2f} s (grid_search), {t_batch:.2f} s (batch) -> "
-          f"{'OK' if min(t_grid, t_batch) < 5 else 'MISSED'}")
+    print(
+        f"  Madgwick 6D >= 10 M samples/s: {mad / 1e6:.1f} M/s -> {'OK' if mad >= 1e7 else 'MISSED'}"
+    )
+    print(
+        f"  EKF 6D >= 1 M samples/s: {ekf / 1e6:.2f} M/s -> {'OK' if ekf >= 1e6 else 'MISSED'}"
+    )
+    print(
+        f"  30-gain grid over 1 M samples < 5 s: {t_grid:.2f} s (grid_search), {t_batch:.2f} s (batch) -> "
+        f"{'OK' if min(t_grid, t_batch) < 5 else 'MISSED'}"
+    )
 
 
 if __name__ == "__main__":

@@ -2,8 +2,8 @@
 
 Run: python benchmarks/bench_quaternion.py [N]
 """
+
 import sys
-import time
 
 import numpy as np
 from scipy.spatial.transform import Rotation
@@ -24,12 +24,18 @@ def main(n: int = 1_000_000) -> None:
         ("rotate", lambda: Q.rotate(q, v), lambda: rq.apply(v)),
         ("gravity", lambda: Q.gravity(q), lambda: rq.inv().apply([0.0, 0.0, 1.0])),
         ("to_matrix", lambda: Q.to_matrix(q), lambda: rq.as_matrix()),
-        ("from_matrix", lambda m=Q.to_matrix(q): Q.from_matrix(m), lambda m=rq.as_matrix(): Rotation.from_matrix(m)),
+        (
+            "from_matrix",
+            lambda m=Q.to_matrix(q): Q.from_matrix(m),
+            lambda m=rq.as_matrix(): Rotation.from_matrix(m),
+        ),
         ("to_rotvec", lambda: Q.to_rotvec(q), lambda: rq.as_rotvec()),
         ("tilt_error", lambda: Q.tilt_error(p, q), None),
         ("integrate_gyro", lambda: Q.integrate_gyro(omega, 100.0), None),
     ]
-    print(f"{'operation':>15} {'tiltlab Msamples/s':>20} {'scipy Msamples/s':>18} {'ratio':>7}   (N = {n:,})")
+    print(
+        f"{'operation':>15} {'tiltlab Msamples/s':>20} {'scipy Msamples/s':>18} {'ratio':>7}   (N = {n:,})"
+    )
     for name, ours, ref in cases:
         t = best_of(ours, 5, warmup=True)
         line = f"{name:>15} {n / t / 1e6:20.1f}"

@@ -20,7 +20,14 @@ from pathlib import Path
 
 import numpy as np
 
-from tiltlab.simulate import CohortDesign, SensorModel, head_kinematics, recording_from_motion, simulate_cohort, simulate_session
+from tiltlab.simulate import (
+    CohortDesign,
+    SensorModel,
+    head_kinematics,
+    recording_from_motion,
+    simulate_cohort,
+    simulate_session,
+)
 
 PAPER_SAMPLES = 58 * 7 * 1200 * 100
 
@@ -34,24 +41,42 @@ def bench_session(repeats: int = 3) -> None:
         t0 = time.perf_counter()
         m = head_kinematics(dur, fs, seed=r)
         t1 = time.perf_counter()
-        recording_from_motion(m, rng=np.random.default_rng(r), sensor=SensorModel(), keep_true=False)
+        recording_from_motion(
+            m, rng=np.random.default_rng(r), sensor=SensorModel(), keep_true=False
+        )
         t2 = time.perf_counter()
         t_kin.append(t1 - t0)
         t_all.append(t2 - t0)
     best = min(t_all)
     print(f"1 h of 300 Hz 6-axis data ({n:,} samples), one core, best of {repeats}:")
-    print(f"  head kinematics     {min(t_kin):6.3f} s   ({n / min(t_kin) / 1e6:5.2f} M samples/s)")
-    print(f"  + sensor model, validated Recording: total {best:6.3f} s   ({n / best / 1e6:5.2f} M samples/s)")
-    print(f"  target < 2 s: {'PASS' if best < 2.0 else 'FAIL'} (ratio to target {best / 2.0:.2f})")
+    print(
+        f"  head kinematics     {min(t_kin):6.3f} s   ({n / min(t_kin) / 1e6:5.2f} M samples/s)"
+    )
+    print(
+        f"  + sensor model, validated Recording: total {best:6.3f} s   ({n / best / 1e6:5.2f} M samples/s)"
+    )
+    print(
+        f"  target < 2 s: {'PASS' if best < 2.0 else 'FAIL'} (ratio to target {best / 2.0:.2f})"
+    )
 
 
-def bench_cohort(design: CohortDesign, duration_s: float, workers: int, keep: bool, label: str) -> float:
+def bench_cohort(
+    design: CohortDesign, duration_s: float, workers: int, keep: bool, label: str
+) -> float:
     n_sessions = sum(design.groups.values()) * len(design.time_points)
     n = n_sessions * int(duration_s * 100)
     tmp = Path(tempfile.mkdtemp(prefix="tiltlab_bench_cohort_"))
     try:
         t0 = time.perf_counter()
-        simulate_cohort(tmp / "cohort", design=design, duration_s=duration_s, fs=100.0, seed=0, workers=workers, progress=True)
+        simulate_cohort(
+            tmp / "cohort",
+            design=design,
+            duration_s=duration_s,
+            fs=100.0,
+            seed=0,
+            workers=workers,
+            progress=True,
+        )
         wall = time.perf_counter() - t0
         size = sum(f.stat().st_size for f in (tmp / "cohort").rglob("*") if f.is_file())
     finally:
@@ -60,15 +85,30 @@ def bench_cohort(design: CohortDesign, duration_s: float, workers: int, keep: bo
         else:
             shutil.rmtree(tmp, ignore_errors=True)
     rate = n / wall
-    print(f"{label}: {n_sessions} sessions × {duration_s:g} s at 100 Hz = {n:,} samples, {workers} workers")
-    print(f"  wall {wall:7.2f} s   {rate / 1e6:5.2f} M samples/s   {size / 1e9:5.2f} GB written")
+    print(
+        f"{label}: {n_sessions} sessions × {duration_s:g} s at 100 Hz = {n:,} samples, {workers} workers"
+    )
+    print(
+        f"  wall {wall:7.2f} s   {rate / 1e6:5.2f} M samples/s   {size / 1e9:5.2f} GB written"
+    )
     return rate
 
 
 def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--full", action="store_true", help="also run the paper-size cohort (20 min sessions)")
-    ap.add_argument("--duration", type=float, default=1200.0, help="session length of the default cohort subset (s)")
+    ap = argparse.ArgumentParser(
+        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
+    ap.add_argument(
+        "--full",
+        action="store_true",
+        help="also run the paper-size cohort (20 min sessions)",
+    )
+    ap.add_argument(
+        "--duration",
+        type=float,
+        default=1200.0,
+        help="session length of the default cohort subset (s)",
+    )
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--keep", action="store_true", help="keep the cohort directories")
     args = ap.parse_args()
@@ -77,15 +117,27 @@ def main() -> None:
     print()
     # default: one animal per group (35 sessions) at the paper's session length; the
     # per-session cost is then representative and extrapolates to the 406 sessions
-    rate = bench_cohort(CohortDesign.small(1), args.duration, args.workers, args.keep, "cohort subset (1 animal per group)")
+    rate = bench_cohort(
+        CohortDesign.small(1),
+        args.duration,
+        args.workers,
+        args.keep,
+        "cohort subset (1 animal per group)",
+    )
     est = PAPER_SAMPLES / rate
-    print(f"  extrapolated paper-size cohort ({PAPER_SAMPLES:,} samples): {est:6.1f} s "
-          f"(target < 180 s: {'PASS' if est < 180 else 'FAIL'}, ratio {est / 180:.2f})")
+    print(
+        f"  extrapolated paper-size cohort ({PAPER_SAMPLES:,} samples): {est:6.1f} s "
+        f"(target < 180 s: {'PASS' if est < 180 else 'FAIL'}, ratio {est / 180:.2f})"
+    )
     if args.full:
         print()
-        rate = bench_cohort(CohortDesign(), 1200.0, args.workers, args.keep, "paper-size cohort")
+        rate = bench_cohort(
+            CohortDesign(), 1200.0, args.workers, args.keep, "paper-size cohort"
+        )
         wall = PAPER_SAMPLES / rate
-        print(f"  measured paper-size time {wall:6.1f} s (target < 180 s: {'PASS' if wall < 180 else 'FAIL'}, ratio {wall / 180:.2f})")
+        print(
+            f"  measured paper-size time {wall:6.1f} s (target < 180 s: {'PASS' if wall < 180 else 'FAIL'}, ratio {wall / 180:.2f})"
+        )
 
 
 if __name__ == "__main__":

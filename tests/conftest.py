@@ -4,6 +4,7 @@ Real-data tests need the reference data: a local mirror named by TILTLAB_DATA_DI
 internet access. Without either they are skipped, unless TILTLAB_REQUIRE_DATA=1 (set by
 .ci/run), in which case missing data is a failure.
 """
+
 import os
 from pathlib import Path
 

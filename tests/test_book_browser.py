@@ -4,6 +4,7 @@ Needs the built book (``make book``) plus Debian's ``chromium`` and ``chromium-d
 Without them the test is skipped, unless TILTLAB_REQUIRE_BOOK=1 (set by .ci/run), which
 turns a missing book or browser into a failure.
 """
+
 import functools
 import http.server
 import os
@@ -19,8 +20,14 @@ pytestmark = pytest.mark.browser
 ROOT = Path(__file__).resolve().parents[1]
 HTML = ROOT / "book" / "_build" / "html"
 CHROMIUM_FLAGS = [
-    "--headless", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
-    "--disable-component-update", "--disable-sync", "--no-first-run", "--disable-dev-shm-usage",
+    "--headless",
+    "--no-sandbox",
+    "--disable-gpu",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--disable-sync",
+    "--no-first-run",
+    "--disable-dev-shm-usage",
 ]
 
 
@@ -45,13 +52,17 @@ def chapter_pages() -> list[str]:
 def server():
     if not (HTML / "index.html").is_file():
         _skip_or_fail(f"the book is not built ({HTML}); run `make book` first")
-    handler = functools.partial(http.server.SimpleHTTPRequestHandler, directory=str(HTML))
+    handler = functools.partial(
+        http.server.SimpleHTTPRequestHandler, directory=str(HTML)
+    )
 
     class Quiet(handler.func):  # type: ignore[misc]
         def log_message(self, *args):
             pass
 
-    httpd = http.server.ThreadingHTTPServer(("127.0.0.1", 0), functools.partial(Quiet, directory=str(HTML)))
+    httpd = http.server.ThreadingHTTPServer(
+        ("127.0.0.1", 0), functools.partial(Quiet, directory=str(HTML))
+    )
     thread = threading.Thread(target=httpd.serve_forever, daemon=True)
     thread.start()
     yield f"http://127.0.0.1:{httpd.server_address[1]}"
@@ -63,7 +74,9 @@ def browser():
     chromium = shutil.which("chromium") or shutil.which("chromium-browser")
     driver_path = shutil.which("chromedriver")
     if not chromium or not driver_path:
-        _skip_or_fail("chromium and chromedriver are not installed (Debian: chromium chromium-driver)")
+        _skip_or_fail(
+            "chromium and chromedriver are not installed (Debian: chromium chromium-driver)"
+        )
     from selenium import webdriver
     from selenium.webdriver.chrome.service import Service
 
@@ -89,7 +102,9 @@ def _wait_for(drv, script: str, timeout: float = 30.0):
 
 def test_toc_lists_pages():
     pages = chapter_pages()
-    assert "conventions.html" in pages and any(p.startswith("notebooks/") for p in pages)
+    assert "conventions.html" in pages and any(
+        p.startswith("notebooks/") for p in pages
+    )
 
 
 @pytest.mark.parametrize("page", chapter_pages())
@@ -103,7 +118,9 @@ def test_page_renders(server, browser, page):
     # no Python error made it into the page
     for marker in ("Traceback (most recent call last)", "CellExecutionError"):
         assert marker not in text, f"{page}: contains {marker!r}"
-    errors = browser.execute_script("return document.querySelectorAll('div.output.error, .output_error, .cell_output .ansi-red-fg').length")
+    errors = browser.execute_script(
+        "return document.querySelectorAll('div.output.error, .output_error, .cell_output .ansi-red-fg').length"
+    )
     assert errors == 0, f"{page}: {errors} error outputs"
     # every image is present, loaded and non-empty
     imgs = browser.execute_script(
@@ -114,15 +131,23 @@ def test_page_renders(server, browser, page):
     if page.startswith("notebooks/"):
         assert len(imgs) >= 1, f"{page}: a chapter without any figure"
     # math: any TeX on the page has been typeset by the vendored MathJax
-    has_math = browser.execute_script("return document.querySelectorAll('.math').length")
+    has_math = browser.execute_script(
+        "return document.querySelectorAll('.math').length"
+    )
     if page == "conventions.html":
         assert has_math > 10, "the conventions page states its equations in TeX"
     if has_math:
-        typeset = _wait_for(browser, "return document.querySelectorAll('mjx-container').length")
-        assert typeset >= has_math, f"{page}: {has_math} math elements but {typeset} typeset"
+        typeset = _wait_for(
+            browser, "return document.querySelectorAll('mjx-container').length"
+        )
+        assert typeset >= has_math, (
+            f"{page}: {has_math} math elements but {typeset} typeset"
+        )
         raw = browser.execute_script(
             "return Array.from(document.querySelectorAll('.math')).filter(e => !e.querySelector('mjx-container')).length"
         )
         assert raw == 0, f"{page}: {raw} math elements left as raw TeX"
-        errs = browser.execute_script("return document.querySelectorAll('mjx-merror').length")
+        errs = browser.execute_script(
+            "return document.querySelectorAll('mjx-merror').length"
+        )
         assert errs == 0, f"{page}: {errs} MathJax errors"

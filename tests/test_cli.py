@@ -1,4 +1,5 @@
 """The command line wraps the package; errors are reported, not raised."""
+
 import numpy as np
 
 from tiltlab import cli, io, schema
@@ -6,7 +7,12 @@ from tiltlab import cli, io, schema
 
 def test_info_and_validate_on_saved_recording(tmp_path, capsys):
     rng = np.random.default_rng(0)
-    rec = schema.make_recording(np.tile([0, 0, 1.0], (100, 1)), rng.normal(0, 0.1, (100, 3)), 50.0, attrs={"session": "s1"})
+    rec = schema.make_recording(
+        np.tile([0, 0, 1.0], (100, 1)),
+        rng.normal(0, 0.1, (100, 3)),
+        50.0,
+        attrs={"session": "s1"},
+    )
     path = io.save_netcdf(rec, tmp_path / "r.nc")
     assert cli.main(["info", str(path)]) == 0
     out = capsys.readouterr().out

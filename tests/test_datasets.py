@@ -1,4 +1,5 @@
 """The data registry: generated from the manifest, checksums enforced, loaders."""
+
 import json
 import shutil
 
@@ -56,7 +57,9 @@ def test_checksum_mismatch_names_the_file(tmp_path, monkeypatch, data_mirror):
     assert d.fetch(name) == mirror / name
     with open(mirror / name, "ab") as f:
         f.write(b"1,2,3,4,5,6,7\n")
-    with pytest.raises(d.DataError, match=r"checksum mismatch for fayat2021/example_imu\.csv"):
+    with pytest.raises(
+        d.DataError, match=r"checksum mismatch for fayat2021/example_imu\.csv"
+    ):
         d.load_fayat_example()
 
 

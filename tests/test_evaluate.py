@@ -2,7 +2,6 @@
 the mocap reference pipeline and DataArray-valued grid searches."""
 
 import numpy as np
-import pandas as pd
 import pytest
 import xarray as xr
 from hypothesis import given, settings
@@ -17,15 +16,27 @@ from tiltlab.schema import make_recording
 def _rec(n=1500, fs=100.0, seed=0):
     rng = np.random.default_rng(seed)
     t = np.arange(n) / fs
-    omega = np.column_stack([1.2 * np.sin(0.9 * t), 0.8 * np.cos(0.5 * t), 0.5 * np.sin(1.3 * t)])
+    omega = np.column_stack(
+        [1.2 * np.sin(0.9 * t), 0.8 * np.cos(0.5 * t), 0.5 * np.sin(1.3 * t)]
+    )
     omega[: n // 3] = 0.0  # a still first third
-    q = Q.integrate_gyro(np.vstack([omega[1:], omega[-1:]]), fs, Q.random_quaternions(1, rng)[0])
+    q = Q.integrate_gyro(
+        np.vstack([omega[1:], omega[-1:]]), fs, Q.random_quaternions(1, rng)[0]
+    )
     acc = Q.gravity(q) + 0.01 * rng.standard_normal((n, 3))
     gyr = np.degrees(omega) + 0.2 * rng.standard_normal((n, 3))
     immobile = np.zeros(n, bool)
     immobile[: n // 3] = True
-    rec = make_recording(acc, gyr, fs, q_ref=q, extra={"immobile": (("time",), immobile, {}),
-                                                       "tilt_ref": (("time", "axis"), Q.gravity(q), {"units": "1"})})
+    rec = make_recording(
+        acc,
+        gyr,
+        fs,
+        q_ref=q,
+        extra={
+            "immobile": (("time",), immobile, {}),
+            "tilt_ref": (("time", "axis"), Q.gravity(q), {"units": "1"}),
+        },
+    )
     return rec, q
 
 
@@ -78,7 +89,10 @@ def test_shift_quaternions_integer_and_fractional():
 def test_shifted_score_recovers_a_delay():
     rec, q = _rec()
     delayed = np.vstack([q[:1], q[:-1]])  # estimate lagging the reference by one sample
-    fn = E.shifted_score([0.0, 0.5, 1.0], score_fn=lambda qq, r: np.nanmean(E.tilt_errors(qq, r["q_ref"].values)))
+    fn = E.shifted_score(
+        [0.0, 0.5, 1.0],
+        score_fn=lambda qq, r: np.nanmean(E.tilt_errors(qq, r["q_ref"].values)),
+    )
     s = fn(delayed, rec)
     assert s.dims == ("shift",) and int(np.argmin(s.values)) == 2
     assert float(s.sel(shift=1.0)) < 0.01 * float(s.sel(shift=0.0))
@@ -120,7 +134,10 @@ def test_binned_by_speed_and_ecdf():
     e = np.r_[np.full(50, 1.0), np.full(50, 3.0)]
     b = E.binned_by_speed({"m": e}, sp, [0, 10, 100, 1000])
     assert b["median"].sel(estimator="m").values[:2].tolist() == [1.0, 3.0]
-    assert np.isnan(b["median"].sel(estimator="m").values[2]) and b["n"].values.sum() == 100
+    assert (
+        np.isnan(b["median"].sel(estimator="m").values[2])
+        and b["n"].values.sum() == 100
+    )
     x, f = E.ecdf(np.r_[3.0, 1.0, np.nan, 2.0])
     assert x.tolist() == [1.0, 2.0, 3.0] and f[-1] == 1.0 and np.all(np.diff(f) > 0)
     with pytest.raises(ValueError):
@@ -133,13 +150,19 @@ def test_binned_by_speed_and_ecdf():
 def test_loto_never_uses_the_held_out_trial():
     # trial a prefers p=1 strongly, b-d prefer p=0 mildly. Without a, p=0 wins, so a is scored at
     # p=0 (5, not its own optimum 0); without b, a's preference carries p=1 (b scored 2).
-    s = xr.DataArray([[5.0, 1.0, 1.0, 1.0], [0.0, 2.0, 2.0, 2.0]], dims=("p", "recording"),
-                     coords={"p": [0, 1], "recording": list("abcd")})
+    s = xr.DataArray(
+        [[5.0, 1.0, 1.0, 1.0], [0.0, 2.0, 2.0, 2.0]],
+        dims=("p", "recording"),
+        coords={"p": [0, 1], "recording": list("abcd")},
+    )
     out = E.loto(s)
     assert out["p"].values.tolist() == [0, 1, 1, 1]
     assert out["score"].values.tolist() == [5.0, 2.0, 2.0, 2.0]
     assert out.attrs["mean"] == pytest.approx(2.75)
-    assert out.attrs["optimistic_mean"] == pytest.approx(1.5) and out.attrs["optimistic_p"] == 1
+    assert (
+        out.attrs["optimistic_mean"] == pytest.approx(1.5)
+        and out.attrs["optimistic_p"] == 1
+    )
     assert out.attrs["mean"] >= out.attrs["optimistic_mean"]
 
 
@@ -147,8 +170,11 @@ def test_loto_never_uses_the_held_out_trial():
 @given(st.integers(0, 10_000))
 def test_loto_is_never_better_than_the_optimistic_optimum(seed):
     rng = np.random.default_rng(seed)
-    s = xr.DataArray(rng.random((3, 4, 5)), dims=("a", "b", "recording"),
-                     coords={"a": [1, 2, 3], "b": [0.1, 0.2, 0.3, 0.4], "recording": range(5)})
+    s = xr.DataArray(
+        rng.random((3, 4, 5)),
+        dims=("a", "b", "recording"),
+        coords={"a": [1, 2, 3], "b": [0.1, 0.2, 0.3, 0.4], "recording": range(5)},
+    )
     out = E.loto(s)
     assert out.attrs["mean"] >= out.attrs["optimistic_mean"] - 1e-12
     best = E.optimum(s)
@@ -162,7 +188,10 @@ def test_loto_errors():
     with pytest.raises(ValueError):
         E.loto(s)
     with pytest.raises(ValueError):
-        E.loto(xr.DataArray(np.ones((2, 3, 2)), dims=("p", "recording", "state")), params=["p"])
+        E.loto(
+            xr.DataArray(np.ones((2, 3, 2)), dims=("p", "recording", "state")),
+            params=["p"],
+        )
 
 
 # ------------------------------------------------------------------ grids, tables
@@ -170,22 +199,32 @@ def test_loto_errors():
 
 def test_grid_search_with_state_scores_and_error_table():
     recs = {i: _rec(seed=i)[0] for i in range(2)}
-    g = F.grid_search(recs, "madgwick", {"beta": [0.05, 0.5]}, E.state_scores, n_jobs=2)
+    g = E.grid_search(recs, "madgwick", {"beta": [0.05, 0.5]}, E.state_scores, n_jobs=2)
     assert g.dims == ("beta", "recording", "state")
     assert g["state"].values.tolist() == ["immobile", "moving", "all"]
     assert np.all(np.isfinite(g.values)) and np.all(g.values >= 0)
     # each cell equals the direct computation
     q = F.estimate(recs[1], "madgwick", beta=0.5)
-    assert np.allclose(g.sel(beta=0.5, recording=1).values, E.state_scores(q, recs[1]).values)
-    t = E.error_table(recs, {"m": lambda r: F.estimate(r, "madgwick", beta=0.5)},
-                      score_fn=lambda qq, r: float(E.state_scores(qq, r).sel(state="all")), n_jobs=2)
+    assert np.allclose(
+        g.sel(beta=0.5, recording=1).values, E.state_scores(q, recs[1]).values
+    )
+    t = E.error_table(
+        recs,
+        {"m": lambda r: F.estimate(r, "madgwick", beta=0.5)},
+        score_fn=lambda qq, r: float(E.state_scores(qq, r).sel(state="all")),
+        n_jobs=2,
+    )
     assert t.dims == ("estimator", "recording")
     assert np.allclose(t.sel(estimator="m").values, g.sel(beta=0.5, state="all").values)
 
 
 def test_pairwise_tilt_rms_symmetric():
     rec, q = _rec()
-    est = {"a": q, "b": F.estimate(rec, "madgwick", beta=0.1), "c": F.estimate(rec, "lowpass", fc=1.0)}
+    est = {
+        "a": q,
+        "b": F.estimate(rec, "madgwick", beta=0.1),
+        "c": F.estimate(rec, "lowpass", cutoff_hz=1.0),
+    }
     p = E.pairwise_tilt_rms(est)
     assert np.allclose(p.values, p.values.T) and np.allclose(np.diag(p.values), 0.0)
     assert np.all(p.values[~np.eye(3, dtype=bool)] > 0)
@@ -199,7 +238,10 @@ def test_adapters_run_and_agree_on_tilt():
         est = F.estimate(rec, m)
         e = E.tilt_errors(est, q)
         assert np.nanmedian(e[100:]) < 5.0
-    a, b = F.estimate(rec, "ahrs_mahony", kp=0.5, ki=0.0), F.estimate(rec, "mahony", kp=0.5, ki=0.0)
+    a, b = (
+        F.estimate(rec, "ahrs_mahony", kp=0.5, ki=0.0),
+        F.estimate(rec, "mahony", kp=0.5, ki=0.0),
+    )
     assert np.max(np.abs(Q.canonical(a.values) - Q.canonical(b.values))) < 1e-6
 
 

@@ -1,4 +1,5 @@
 """Readers and writers: real files, generic CSV, NetCDF round trip, damaged files."""
+
 import shutil
 
 import numpy as np
@@ -32,7 +33,10 @@ def test_read_fayat_tumble(fayat_dir):
     np.testing.assert_allclose(np.diff(rec.time.values), 1 / 300, rtol=1e-6)
 
 
-@pytest.mark.parametrize("name", ["02_undisturbed_slow_rotation_B.hdf5", "01_undisturbed_slow_rotation_A.mat"])
+@pytest.mark.parametrize(
+    "name",
+    ["02_undisturbed_slow_rotation_B.hdf5", "01_undisturbed_slow_rotation_A.mat"],
+)
 def test_read_broad_both_layouts(data_mirror, name):
     rec = io.read_broad(data_mirror / "broad" / name)
     assert rec.attrs["fs"] == pytest.approx(285.714285714, rel=1e-9)
@@ -55,10 +59,14 @@ def test_mat_and_hdf5_layouts_agree(tmp_path, data_mirror):
     scipy.io.savemat(
         tmp_path / "02.mat",
         {
-            "imu_acc": rec.acc.values, "imu_gyr": rec.gyr.values, "imu_mag": rec.mag.values,
-            "opt_quat": rec.q_ref.values, "opt_pos": rec.opt_pos.values,
+            "imu_acc": rec.acc.values,
+            "imu_gyr": rec.gyr.values,
+            "imu_mag": rec.mag.values,
+            "opt_quat": rec.q_ref.values,
+            "opt_pos": rec.opt_pos.values,
             "movement": rec.movement.values.astype(np.uint8)[:, None],
-            "sampling_rate": np.array([[rec.attrs["fs"]]]), "info": np.array([rec.attrs["info"]]),
+            "sampling_rate": np.array([[rec.attrs["fs"]]]),
+            "info": np.array([rec.attrs["info"]]),
         },
     )
     back = io.read_broad(tmp_path / "02.mat")
@@ -74,24 +82,45 @@ def test_generic_csv(tmp_path):
     gyr = rng.normal(0, 0.01, (n, 3))
     t = 10.0 + np.arange(n) / fs
     lines = ["T;AX;AY;AZ;GX;GY;GZ;TEMP"] + [
-        ";".join(f"{v:.17g}" for v in (t[i], *acc[i], *gyr[i], 25.0 + i * 0.001)) for i in range(n)
+        ";".join(f"{v:.17g}" for v in (t[i], *acc[i], *gyr[i], 25.0 + i * 0.001))
+        for i in range(n)
     ]
     p = tmp_path / "log.csv"
     p.write_text("\n".join(lines))
     rec = io.read_csv(
-        p, {"acc": ["AX", "AY", "AZ"], "gyr": ["GX", "GY", "GZ"], "temp": "TEMP"},
-        {"acc": "m/s^2", "gyr": "rad/s", "temp": "degC"}, time_column="T", sep=";",
+        p,
+        {"acc": ["AX", "AY", "AZ"], "gyr": ["GX", "GY", "GZ"], "temp": "TEMP"},
+        {"acc": "m/s^2", "gyr": "rad/s", "temp": "degC"},
+        time_column="T",
+        sep=";",
     )
     assert rec.attrs["fs"] == pytest.approx(fs) and "fs_source" in rec.attrs
     np.testing.assert_array_equal(rec.acc.values, acc)
     np.testing.assert_array_equal(rec.time.values, t)
     assert rec.temp.attrs["units"] == "degC"
     with pytest.raises(ValueError, match="units must give the unit of 'gyr'"):
-        io.read_csv(p, {"acc": ["AX", "AY", "AZ"], "gyr": ["GX", "GY", "GZ"]}, {"acc": "g"}, fs=fs, sep=";")
+        io.read_csv(
+            p,
+            {"acc": ["AX", "AY", "AZ"], "gyr": ["GX", "GY", "GZ"]},
+            {"acc": "g"},
+            fs=fs,
+            sep=";",
+        )
     with pytest.raises(ValueError, match="never assumes a sampling rate"):
-        io.read_csv(p, {"acc": ["AX", "AY", "AZ"], "gyr": ["GX", "GY", "GZ"]}, {"acc": "g", "gyr": "rad/s"}, sep=";")
+        io.read_csv(
+            p,
+            {"acc": ["AX", "AY", "AZ"], "gyr": ["GX", "GY", "GZ"]},
+            {"acc": "g", "gyr": "rad/s"},
+            sep=";",
+        )
     with pytest.raises(ReadError, match="missing column"):
-        io.read_csv(p, {"acc": ["AX", "AY", "Q"], "gyr": ["GX", "GY", "GZ"]}, {"acc": "g", "gyr": "rad/s"}, fs=fs, sep=";")
+        io.read_csv(
+            p,
+            {"acc": ["AX", "AY", "Q"], "gyr": ["GX", "GY", "GZ"]},
+            {"acc": "g", "gyr": "rad/s"},
+            fs=fs,
+            sep=";",
+        )
 
 
 def test_truncated_and_corrupt_files(tmp_path, data_mirror):
@@ -128,12 +157,29 @@ def test_netcdf_round_trip_is_exact(tmp_path):
     n = 500
     q = Q.random_quaternions(n, rng)
     rec = schema.make_recording(
-        Q.gravity(q), rng.normal(0, 1, (n, 3)), 200.0, q_ref=q,
-        mag=rng.normal(0, 30, (n, 3)), temp=25 + rng.normal(0, 0.1, n),
-        extra={"moving": ("time", rng.random(n) > 0.5, {"long_name": "a mask"}),
-               "state": ("time", rng.integers(0, 4, n).astype(np.int8), {"legend": {"0": "still", "1": "walk"}})},
-        attrs={"subject": "rat 7", "flag": True, "none": None, "offsets": [0.1, -0.2, 0.05],
-               "nested": {"a": 1, "b": [1, 2]}, "arr": np.arange(3.0), "n": np.int64(4)},
+        Q.gravity(q),
+        rng.normal(0, 1, (n, 3)),
+        200.0,
+        q_ref=q,
+        mag=rng.normal(0, 30, (n, 3)),
+        temp=25 + rng.normal(0, 0.1, n),
+        extra={
+            "moving": ("time", rng.random(n) > 0.5, {"long_name": "a mask"}),
+            "state": (
+                "time",
+                rng.integers(0, 4, n).astype(np.int8),
+                {"legend": {"0": "still", "1": "walk"}},
+            ),
+        },
+        attrs={
+            "subject": "rat 7",
+            "flag": True,
+            "none": None,
+            "offsets": [0.1, -0.2, 0.05],
+            "nested": {"a": 1, "b": [1, 2]},
+            "arr": np.arange(3.0),
+            "n": np.int64(4),
+        },
         check_units=False,
     )
     path = io.save_netcdf(rec, tmp_path / "sub" / "r.nc")

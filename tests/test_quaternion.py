@@ -1,4 +1,5 @@
 """Quaternion kernels against scipy.spatial.transform.Rotation, and their invariants."""
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -51,7 +52,9 @@ def test_special_cases_against_scipy():
     np.testing.assert_allclose(Q.to_rotvec(q[:5:4]), r[:5:4].as_rotvec(), atol=TOL)
     np.testing.assert_allclose(Q.to_rotvec(q[7:11]), r[7:11].as_rotvec(), atol=TOL)
     m = r.as_matrix()
-    np.testing.assert_allclose(np.abs(np.sum(Q.from_matrix(m) * q, axis=1)), 1.0, atol=TOL)
+    np.testing.assert_allclose(
+        np.abs(np.sum(Q.from_matrix(m) * q, axis=1)), 1.0, atol=TOL
+    )
 
 
 @given(unit_quats(), unit_quats())
@@ -59,7 +62,10 @@ def test_special_cases_against_scipy():
 def test_mul_matches_scipy_composition(p, q):
     n = min(len(p), len(q))
     p, q = p[:n], q[:n]
-    ref = (Rotation.from_quat(p, scalar_first=True) * Rotation.from_quat(q, scalar_first=True)).as_quat(scalar_first=True)
+    ref = (
+        Rotation.from_quat(p, scalar_first=True)
+        * Rotation.from_quat(q, scalar_first=True)
+    ).as_quat(scalar_first=True)
     np.testing.assert_allclose(Q.canonical(Q.mul(p, q)), Q.canonical(ref), atol=TOL)
 
 
@@ -69,9 +75,15 @@ def test_rotate_matches_scipy_apply(q, v):
     r = Rotation.from_quat(q, scalar_first=True)
     scale = max(1.0, np.abs(v).max())
     np.testing.assert_allclose(Q.rotate(q, v), r.apply(v), atol=TOL * scale)
-    np.testing.assert_allclose(Q.rotate_inverse(q, v), r.inv().apply(v), atol=TOL * scale)
+    np.testing.assert_allclose(
+        Q.rotate_inverse(q, v), r.inv().apply(v), atol=TOL * scale
+    )
     # round trip
-    np.testing.assert_allclose(Q.rotate_inverse(q, Q.rotate(q, v)), np.broadcast_to(v, (len(q), 3)), atol=TOL * scale)
+    np.testing.assert_allclose(
+        Q.rotate_inverse(q, Q.rotate(q, v)),
+        np.broadcast_to(v, (len(q), 3)),
+        atol=TOL * scale,
+    )
 
 
 @given(unit_quats())
@@ -81,20 +93,28 @@ def test_matrix_and_rotvec_round_trips(q):
     m = Q.to_matrix(q)
     np.testing.assert_allclose(m, r.as_matrix(), atol=TOL)
     # q and -q are the same rotation (and both are 'canonical' when w = 0): compare up to sign
-    np.testing.assert_allclose(np.abs(np.sum(Q.from_matrix(m) * q, axis=1)), 1.0, atol=1e-12)
+    np.testing.assert_allclose(
+        np.abs(np.sum(Q.from_matrix(m) * q, axis=1)), 1.0, atol=1e-12
+    )
     rv = Q.to_rotvec(q)
     angle = np.linalg.norm(rv, axis=1)
     ok = angle < np.pi - 1e-6  # the axis sign is ambiguous at exactly π
     np.testing.assert_allclose(rv[ok], r[ok].as_rotvec(), atol=TOL)
-    np.testing.assert_allclose(np.abs(np.sum(Q.from_rotvec(rv) * q, axis=1)), 1.0, atol=1e-12)
-    np.testing.assert_allclose(np.abs(np.sum(Q.exp(Q.log(q)) * q, axis=1)), 1.0, atol=1e-12)
+    np.testing.assert_allclose(
+        np.abs(np.sum(Q.from_rotvec(rv) * q, axis=1)), 1.0, atol=1e-12
+    )
+    np.testing.assert_allclose(
+        np.abs(np.sum(Q.exp(Q.log(q)) * q, axis=1)), 1.0, atol=1e-12
+    )
 
 
 @given(unit_quats())
 @settings(max_examples=60, deadline=None)
 def test_gravity_is_world_up_in_sensor_frame(q):
     g = Q.gravity(q)
-    np.testing.assert_allclose(g, Rotation.from_quat(q, scalar_first=True).inv().apply([0, 0, 1]), atol=TOL)
+    np.testing.assert_allclose(
+        g, Rotation.from_quat(q, scalar_first=True).inv().apply([0, 0, 1]), atol=TOL
+    )
     np.testing.assert_allclose(np.linalg.norm(g, axis=1), 1.0, atol=TOL)
 
 
@@ -104,11 +124,16 @@ def test_error_angles(p, q):
     n = min(len(p), len(q))
     p, q = p[:n], q[:n]
     # total error = angle of the relative rotation (scipy's magnitude)
-    rel = Rotation.from_quat(p, scalar_first=True) * Rotation.from_quat(q, scalar_first=True).inv()
+    rel = (
+        Rotation.from_quat(p, scalar_first=True)
+        * Rotation.from_quat(q, scalar_first=True).inv()
+    )
     np.testing.assert_allclose(Q.total_error(p, q), rel.magnitude(), atol=1e-9)
     # tilt error = angle between gravity directions in the sensor frame = BROAD's inclination error
     tilt = Q.tilt_error(p, q)
-    np.testing.assert_allclose(tilt, Q.angle_between(Q.gravity(p), Q.gravity(q)), atol=1e-9)
+    np.testing.assert_allclose(
+        tilt, Q.angle_between(Q.gravity(p), Q.gravity(q)), atol=1e-9
+    )
     e = Q.error_quaternion(p, q)
     broad = 2 * np.arccos(np.clip(np.sqrt(e[:, 0] ** 2 + e[:, 3] ** 2), 0, 1))
     np.testing.assert_allclose(tilt, broad, atol=1e-6)  # arccos loses precision near 0
@@ -120,7 +145,9 @@ def test_error_angles(p, q):
     # except where it is undefined (inclination error near 180°: w and z of the error both ~0)
     s = Q.random_quaternions(1, 7)
     ok = np.hypot(e[:, 0], e[:, 3]) > 1e-4
-    np.testing.assert_allclose(Q.heading_error(Q.mul(p, s), Q.mul(q, s))[ok], head[ok], atol=1e-8)
+    np.testing.assert_allclose(
+        Q.heading_error(Q.mul(p, s), Q.mul(q, s))[ok], head[ok], atol=1e-8
+    )
 
 
 def test_heading_and_tilt_errors_of_pure_rotations():
@@ -185,7 +212,9 @@ def test_integrate_gyro_matches_scipy_step_composition(omega, fs):
 def test_scipy_conversion_is_explicit_about_order():
     q = np.array([np.cos(0.2), np.sin(0.2), 0.0, 0.0])
     r = Q.to_scipy(q)
-    np.testing.assert_allclose(r.as_quat(), [np.sin(0.2), 0, 0, np.cos(0.2)])  # scipy: scalar last
+    np.testing.assert_allclose(
+        r.as_quat(), [np.sin(0.2), 0, 0, np.cos(0.2)]
+    )  # scipy: scalar last
     np.testing.assert_allclose(Q.from_scipy(r), q)
 
 

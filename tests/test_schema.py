@@ -1,4 +1,5 @@
 """The Recording contract: constructor, validation errors, unit conversions."""
+
 import numpy as np
 import pytest
 import xarray as xr
@@ -14,7 +15,9 @@ def rotating_sensor(n=2000, fs=100.0, seed=0):
     """A sensor turning about a tilted axis: acc = specific force of gravity (g), gyr (deg/s)."""
     rng = np.random.default_rng(seed)
     t = np.arange(n) / fs
-    omega = np.column_stack([2.0 * np.sin(0.7 * t), 1.5 * np.cos(0.5 * t), 0.5 + 0 * t])  # rad/s
+    omega = np.column_stack(
+        [2.0 * np.sin(0.7 * t), 1.5 * np.cos(0.5 * t), 0.5 + 0 * t]
+    )  # rad/s
     q = Q.integrate_gyro(omega, fs, Q.random_quaternions(1, rng)[0])
     acc = Q.gravity(q) + rng.normal(0, 0.01, (n, 3))
     return acc, np.degrees(omega), q, fs
@@ -24,9 +27,18 @@ def test_make_recording_structure():
     acc, gyr, q, fs = rotating_sensor()
     rec = schema.make_recording(acc, gyr, fs, q_ref=q, attrs={"subject": "r1"})
     assert rec.sizes == {"time": 2000, "axis": 3, "quat": 4}
-    assert list(rec.axis.values) == ["x", "y", "z"] and list(rec.quat.values) == ["w", "x", "y", "z"]
+    assert list(rec.axis.values) == ["x", "y", "z"] and list(rec.quat.values) == [
+        "w",
+        "x",
+        "y",
+        "z",
+    ]
     assert rec.acc.attrs["units"] == "g" and rec.gyr.attrs["units"] == "deg/s"
-    assert rec.attrs["fs"] == fs and rec.attrs["frame"] == "sensor" and rec.attrs["subject"] == "r1"
+    assert (
+        rec.attrs["fs"] == fs
+        and rec.attrs["frame"] == "sensor"
+        and rec.attrs["subject"] == "r1"
+    )
     np.testing.assert_allclose(np.diff(rec.time.values), 1 / fs)
     assert schema.provenance(rec)["subject"] == "r1"
 
@@ -46,8 +58,14 @@ def test_inputs_are_not_mutated_or_aliased():
         (lambda r: r.attrs.__setitem__("fs", -5), "positive"),
         (lambda r: r.attrs.__setitem__("fs", "fast"), "number of Hz"),
         (lambda r: r.attrs.pop("frame"), "'frame'"),
-        (lambda r: r["gyr"].attrs.__setitem__("units", "furlong/fortnight"), "unknown unit"),
-        (lambda r: r["gyr"].attrs.__setitem__("units", "g"), "do not measure angular velocity"),
+        (
+            lambda r: r["gyr"].attrs.__setitem__("units", "furlong/fortnight"),
+            "unknown unit",
+        ),
+        (
+            lambda r: r["gyr"].attrs.__setitem__("units", "g"),
+            "do not measure angular velocity",
+        ),
         (lambda r: r["acc"].attrs.pop("units"), "no 'units'"),
     ],
 )
@@ -127,7 +145,12 @@ def test_static_recording_passes_unit_check():
     schema.make_recording(acc, gyr, 100.0)
 
 
-@given(st.floats(-1e3, 1e3, allow_nan=False), st.sampled_from([("g", "m/s^2"), ("deg/s", "rad/s"), ("uT", "nT"), ("gauss", "uT")]))
+@given(
+    st.floats(-1e3, 1e3, allow_nan=False),
+    st.sampled_from(
+        [("g", "m/s^2"), ("deg/s", "rad/s"), ("uT", "nT"), ("gauss", "uT")]
+    ),
+)
 @settings(max_examples=100, deadline=None)
 def test_unit_conversions_round_trip(x, pair):
     a, b = pair

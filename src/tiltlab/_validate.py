@@ -96,10 +96,17 @@ def finite(value, name: str) -> float:
     return v
 
 
-def positive(value, name: str, *, allow_zero: bool = False, allow_inf: bool = False) -> float:
+def positive(
+    value, name: str, *, allow_zero: bool = False, allow_inf: bool = False
+) -> float:
     """``value`` as a positive float (``> 0``, or ``>= 0`` with ``allow_zero``)."""
     v = _number(value, name)
-    if np.isnan(v) or (np.isinf(v) and not allow_inf) or v < 0 or (v == 0 and not allow_zero):
+    if (
+        np.isnan(v)
+        or (np.isinf(v) and not allow_inf)
+        or v < 0
+        or (v == 0 and not allow_zero)
+    ):
         kind = "non-negative" if allow_zero else "positive"
         raise ValueError(f"{name} must be a {kind} number, got {value!r}")
     return v
@@ -125,7 +132,9 @@ def integer(value, name: str, *, minimum: int | None = None) -> int:
     return int(v)
 
 
-def fraction(value, name: str, *, open_low: bool = False, open_high: bool = False) -> float:
+def fraction(
+    value, name: str, *, open_low: bool = False, open_high: bool = False
+) -> float:
     """``value`` as a float in [0, 1] (ends excluded with ``open_low`` / ``open_high``)."""
     v = finite(value, name)
     if v < 0 or v > 1 or (open_low and v == 0) or (open_high and v == 1):
@@ -138,8 +147,15 @@ def fraction(value, name: str, *, open_low: bool = False, open_high: bool = Fals
 # --------------------------------------------------------------------------- arrays
 
 
-def vectors(a, name: str, *, width: int | None = 3, ndim: int | None = 2,
-            allow_nan: bool = False, min_length: int = 0) -> np.ndarray:
+def vectors(
+    a,
+    name: str,
+    *,
+    width: int | None = 3,
+    ndim: int | None = 2,
+    allow_nan: bool = False,
+    min_length: int = 0,
+) -> np.ndarray:
     """A float copy of ``a`` checked for shape and finiteness.
 
     Parameters
@@ -165,9 +181,13 @@ def vectors(a, name: str, *, width: int | None = 3, ndim: int | None = 2,
         shape = "(N, {})".format(width) if (ndim == 2 and width) else f"{ndim}-D"
         raise ValueError(f"{name} must have shape {shape}, got {x.shape}")
     if width is not None and (x.ndim == 0 or x.shape[-1] != width):
-        raise ValueError(f"{name} must have a last dimension of size {width}, got shape {x.shape}")
+        raise ValueError(
+            f"{name} must have a last dimension of size {width}, got shape {x.shape}"
+        )
     if x.ndim and x.shape[0] < min_length:
-        raise ValueError(f"{name} needs at least {min_length} samples, got {x.shape[0]}")
+        raise ValueError(
+            f"{name} needs at least {min_length} samples, got {x.shape[0]}"
+        )
     bad = ~np.isfinite(x) if not allow_nan else np.isinf(x)
     if bad.any():
         what = "non-finite" if not allow_nan else "infinite"
@@ -256,7 +276,9 @@ def signal(
     if isinstance(data, xr.Dataset):
         key = var or name
         if key not in data:
-            raise RecordingError(f"the Recording has no variable {key!r} (needed for {name})")
+            raise RecordingError(
+                f"the Recording has no variable {key!r} (needed for {name})"
+            )
         da = data[key]
         attrs = dict(data.attrs)
         own_fs = data.attrs.get("fs")
@@ -286,7 +308,9 @@ def signal(
     if own_fs is not None:
         f = check_fs(own_fs, name=f"{where} attribute fs")
         if fs is not None and not np.isclose(check_fs(fs), f, rtol=1e-9, atol=0.0):
-            raise RecordingError(f"{name}: fs = {fs!r} contradicts the data's attribute fs = {f:g} Hz")
+            raise RecordingError(
+                f"{name}: fs = {fs!r} contradicts the data's attribute fs = {f:g} Hz"
+            )
     elif fs is not None:
         f = check_fs(fs)
     elif need_fs:
@@ -302,7 +326,9 @@ def signal(
     if own_units is not None:
         u = _units.normalise_unit(own_units)
         if units is not None and _units.normalise_unit(units) != u:
-            raise RecordingError(f"{name}: units = {units!r} contradicts the data's units {own_units!r}")
+            raise RecordingError(
+                f"{name}: units = {units!r} contradicts the data's units {own_units!r}"
+            )
     elif units is not None:
         u = _units.normalise_unit(units)
     if u is None and (need_units or to_units is not None):
@@ -314,9 +340,16 @@ def signal(
     return Signal(values, f, u, time, labelled, attrs)
 
 
-def labelled(values, like: Signal, name: str, *, units: str | None = None,
-             dims: tuple[str, ...] | None = None, coords: dict | None = None,
-             attrs: dict[str, Any] | None = None):
+def labelled(
+    values,
+    like: Signal,
+    name: str,
+    *,
+    units: str | None = None,
+    dims: tuple[str, ...] | None = None,
+    coords: dict | None = None,
+    attrs: dict[str, Any] | None = None,
+):
     """Wrap a per-sample result as a DataArray when its input was labelled, else return it.
 
     The output keeps the input's ``time`` coordinate and ``fs``; ``units`` and ``attrs``
@@ -330,7 +363,11 @@ def labelled(values, like: Signal, name: str, *, units: str | None = None,
         if values.ndim == 2 and values.shape[1] == 3:
             dims = ("time", "axis")
     c = {}
-    if like.time is not None and "time" in dims and values.shape[dims.index("time")] == like.time.size:
+    if (
+        like.time is not None
+        and "time" in dims
+        and values.shape[dims.index("time")] == like.time.size
+    ):
         c["time"] = like.time
     if "axis" in dims:
         c["axis"] = ["x", "y", "z"]

@@ -13,33 +13,29 @@ from __future__ import annotations
 
 import argparse
 import sys
-from pathlib import Path
 
 __all__ = ["main"]
 
 
 def _load(spec: str):
-    from . import datasets, io
+    from . import datasets
 
-    if spec.startswith("broad:"):
-        return datasets.load_broad_trial(int(spec.split(":", 1)[1]))
-    if spec == "fayat:example":
-        return datasets.load_fayat_example()
-    if spec == "fayat:tumble":
-        return datasets.load_fayat_tumble()
-    path = Path(spec)
-    if path.suffix.lower() in (".nc", ".netcdf"):
-        return io.load_netcdf(path)
-    if path.suffix.lower() in (".hdf5", ".h5", ".mat"):
-        return io.read_broad(path)
-    raise SystemExit(f"tiltlab: don't know how to read {spec!r} (use broad:N, fayat:example, fayat:tumble, or a .nc/.hdf5/.mat file)")
+    return datasets.load(spec)
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="tiltlab", description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(
+        prog="tiltlab", description=__doc__.splitlines()[0]
+    )
     sub = parser.add_subparsers(dest="cmd", required=True)
-    p_fetch = sub.add_parser("fetch", help="fetch registered data files (checksums verified)")
-    p_fetch.add_argument("names", nargs="*", help="registry names, e.g. broad/02_undisturbed_slow_rotation_B.hdf5")
+    p_fetch = sub.add_parser(
+        "fetch", help="fetch registered data files (checksums verified)"
+    )
+    p_fetch.add_argument(
+        "names",
+        nargs="*",
+        help="registry names, e.g. broad/02_undisturbed_slow_rotation_B.hdf5",
+    )
     p_fetch.add_argument("--all", action="store_true", help="every registered file")
     p_info = sub.add_parser("info", help="summarise a recording")
     p_info.add_argument("source")

@@ -42,6 +42,7 @@ __all__ = [
     "load_fayat_example",
     "load_fayat_tumble",
     "citation",
+    "load",
 ]
 
 ENV_DATA_DIR = "TILTLAB_DATA_DIR"
@@ -72,11 +73,15 @@ def registry() -> dict[str, dict[str, str]]:
 
 def citation(dataset: str) -> str:
     """Citation of a registered data set (``"broad"`` or ``"fayat2021"``)."""
-    meta = json.loads((resources.files("tiltlab") / "_registry" / "datasets.json").read_text())
+    meta = json.loads(
+        (resources.files("tiltlab") / "_registry" / "datasets.json").read_text()
+    )
     try:
         return meta["datasets"][dataset]["citation"]
     except KeyError:
-        raise DataError(f"unknown data set {dataset!r}; known: {sorted(meta['datasets'])}") from None
+        raise DataError(
+            f"unknown data set {dataset!r}; known: {sorted(meta['datasets'])}"
+        ) from None
 
 
 def data_dir() -> Path | None:
@@ -140,7 +145,9 @@ def fetch(name: str, *, progressbar: bool = False) -> Path:
     target = cache / name
     if os.environ.get(ENV_OFFLINE, "").strip() not in ("", "0"):
         if not target.is_file():
-            raise DataError(f"{name} is not cached in {cache} and {ENV_OFFLINE} forbids downloading it")
+            raise DataError(
+                f"{name} is not cached in {cache} and {ENV_OFFLINE} forbids downloading it"
+            )
         return verify(target, name)
     try:
         path = pooch.retrieve(
@@ -151,9 +158,13 @@ def fetch(name: str, *, progressbar: bool = False) -> Path:
             downloader=pooch.HTTPDownloader(timeout=60, progressbar=progressbar),
         )
     except ValueError as exc:  # pooch's hash mismatch
-        raise DataError(f"checksum mismatch for {name} downloaded from {reg[name]['url']}: {exc}") from None
+        raise DataError(
+            f"checksum mismatch for {name} downloaded from {reg[name]['url']}: {exc}"
+        ) from None
     except Exception as exc:
-        raise DataError(f"could not download {name} from {reg[name]['url']}: {type(exc).__name__}: {exc}") from None
+        raise DataError(
+            f"could not download {name} from {reg[name]['url']}: {type(exc).__name__}: {exc}"
+        ) from None
     return Path(path)
 
 
@@ -194,7 +205,9 @@ def load_broad_trial(trial: int | str) -> xr.Dataset:
             raise DataError(f"no BROAD trial named {trial!r}")
         trial = matches[0]
     if trial not in trials:
-        raise DataError(f"BROAD trial {trial} is not available; available: {sorted(trials)}")
+        raise DataError(
+            f"BROAD trial {trial} is not available; available: {sorted(trials)}"
+        )
     return io.read_broad(fetch(trials[trial]))
 
 
@@ -206,3 +219,47 @@ def load_fayat_example() -> xr.Dataset:
 def load_fayat_tumble() -> xr.Dataset:
     """Fayat et al.'s tumble-test recording (300 Hz, sensor still in several orientations)."""
     return io.read_fayat_tumble(fetch("fayat2021/example_sensor_calibration.csv"))
+
+
+def load(source: str | os.PathLike) -> xr.Dataset:
+    """Load a Recording from a data-source string: the one entry point chapters and the CLI use.
+
+    Parameters
+    ----------
+    source : str or path
+        ``"broad:N"`` (BROAD trial N), ``"fayat:example"`` (rat head IMU, 100 Hz),
+        ``"fayat:tumble"`` (tumble test, 300 Hz), or a file: NetCDF (``.nc``) written by
+        :func:`tiltlab.io.save_netcdf`, or a BROAD-layout ``.hdf5``/``.h5``/``.mat`` file.
+
+    Returns
+    -------
+    xarray.Dataset
+        The Recording, with its ``fs`` and units in attrs.
+
+    Raises
+    ------
+    DataError
+        If the source is neither a known name nor a readable file type.
+    """
+    spec = os.fspath(source)
+    if spec.startswith("broad:"):
+        trial = spec.split(":", 1)[1]
+        return load_broad_trial(int(trial) if trial.isdigit() else trial)
+    if spec == "fayat:example":
+        return load_fayat_example()
+    if spec == "fayat:tumble":
+        return load_fayat_tumble()
+    path = Path(spec)
+    suffix = path.suffix.lower()
+    if suffix in (".nc", ".netcdf"):
+        if not path.exists():
+            raise DataError(f"source {spec!r}: no such file")
+        return io.load_netcdf(path)
+    if suffix in (".hdf5", ".h5", ".mat"):
+        if not path.exists():
+            raise DataError(f"source {spec!r}: no such file")
+        return io.read_broad(path)
+    raise DataError(
+        f"don't know how to read {spec!r}: use broad:N, fayat:example, fayat:tumble, "
+        "or a .nc / .hdf5 / .mat file"
+    )

@@ -30,14 +30,18 @@ from .intervals import intervals_to_mask, mask_to_intervals, samples_below
 __all__ = ["lowpass", "moving_mean", "moving_std", "still_mask", "window_samples"]
 
 
-def window_samples(window_s: float, fs: float, *, minimum: int = 1, name: str = "window_s") -> int:
+def window_samples(
+    window_s: float, fs: float, *, minimum: int = 1, name: str = "window_s"
+) -> int:
     """Number of samples in a window of ``window_s`` seconds at ``fs`` (rounded, ≥ ``minimum``)."""
     window_s = _v.positive(window_s, name)
     fs = _v.check_fs(fs)
     return max(int(round(window_s * fs)), int(minimum))
 
 
-def lowpass(x, fs: float, cutoff_hz: float, *, order: int = 2, name: str = "x") -> np.ndarray:
+def lowpass(
+    x, fs: float, cutoff_hz: float, *, order: int = 2, name: str = "x"
+) -> np.ndarray:
     """Zero-phase Butterworth low-pass along the first axis.
 
     Parameters
@@ -70,7 +74,9 @@ def lowpass(x, fs: float, cutoff_hz: float, *, order: int = 2, name: str = "x") 
     cutoff_hz = _v.positive(cutoff_hz, "cutoff_hz")
     order = _v.integer(order, "order", minimum=1)
     if cutoff_hz >= fs / 2:
-        raise ValueError(f"cutoff_hz must be below the Nyquist frequency {fs / 2:g} Hz, got {cutoff_hz:g}")
+        raise ValueError(
+            f"cutoff_hz must be below the Nyquist frequency {fs / 2:g} Hz, got {cutoff_hz:g}"
+        )
     a = _v.vectors(x, name, width=None, ndim=None)
     if a.ndim == 0:
         raise ValueError(f"{name} must have a time dimension")
@@ -155,8 +161,12 @@ def still_mask(
     if acc_norm is not None and acc_std_threshold is not None:
         an = _v.vectors(acc_norm, "acc_norm", width=None, ndim=1)
         if an.shape != s.shape:
-            raise ValueError(f"acc_norm must have one value per sample ({s.size}), got {an.size}")
-        still &= moving_std(an, max(n, 3)) < _v.positive(acc_std_threshold, "acc_std_threshold")
+            raise ValueError(
+                f"acc_norm must have one value per sample ({s.size}), got {an.size}"
+            )
+        still &= moving_std(an, max(n, 3)) < _v.positive(
+            acc_std_threshold, "acc_std_threshold"
+        )
     iv = mask_to_intervals(still, merge_gap=samples_below(merge_gap_s, fs))
     trim = int(round(trim_s * fs))
     if trim:

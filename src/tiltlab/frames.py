@@ -69,6 +69,7 @@ __all__ = [
 Convention = Literal["tiltlab", "benhamou"]
 _GOLDEN = (1.0 + 5.0**0.5) / 2.0
 
+
 class Orientation(NamedTuple):
     """Azimuth θ, elevation φ and bank λ (rad)."""
 
@@ -77,11 +78,12 @@ class Orientation(NamedTuple):
     bank: np.ndarray
 
 
-
 def _vec3(a, name: str) -> np.ndarray:
     a = np.asarray(a, dtype=float)
     if a.ndim == 0 or a.shape[-1] != 3:
-        raise ValueError(f"{name} must have a last dimension of size 3, got shape {a.shape}")
+        raise ValueError(
+            f"{name} must have a last dimension of size 3, got shape {a.shape}"
+        )
     return a
 
 
@@ -105,11 +107,9 @@ def wrap_angle(angle) -> np.ndarray:
     return np.where(w == -np.pi, np.pi, w)
 
 
-
 # ---------------------------------------------------------------------------
 # Benhamou's notation and the body frame (§1)
 # ---------------------------------------------------------------------------
-
 
 
 def _rot(angle, i: int, j: int, sign: float) -> np.ndarray:
@@ -151,7 +151,9 @@ def R3(angle) -> np.ndarray:
 def unit_vector(xi, psi) -> np.ndarray:
     r"""Benhamou's :math:`[\xi\bullet\psi] = (\cos\xi\cos\psi, \sin\xi\cos\psi, \sin\psi)`, shape (..., 3)."""
     xi, psi = np.broadcast_arrays(np.asarray(xi, float), np.asarray(psi, float))
-    return np.stack([np.cos(xi) * np.cos(psi), np.sin(xi) * np.cos(psi), np.sin(psi)], axis=-1)
+    return np.stack(
+        [np.cos(xi) * np.cos(psi), np.sin(xi) * np.cos(psi), np.sin(psi)], axis=-1
+    )
 
 
 def spherical_coords(v) -> tuple[np.ndarray, np.ndarray]:
@@ -161,7 +163,9 @@ def spherical_coords(v) -> tuple[np.ndarray, np.ndarray]:
     ξ = atan2(v_y, v_x) is 0 on the poles (documented fallback).
     """
     v = _vec3(v, "v")
-    return np.arctan2(v[..., 1], v[..., 0]), np.arctan2(v[..., 2], np.hypot(v[..., 0], v[..., 1]))
+    return np.arctan2(v[..., 1], v[..., 0]), np.arctan2(
+        v[..., 2], np.hypot(v[..., 0], v[..., 1])
+    )
 
 
 def to_benhamou_acc(acc) -> np.ndarray:
@@ -217,7 +221,9 @@ def angles_from_matrix(matrix, singular_tol: float = 1e-9) -> Orientation:
     az = np.arctan2(C[..., 1, 0], C[..., 0, 0])
     bk = np.arctan2(C[..., 2, 1], C[..., 2, 2])
     sing = h < singular_tol
-    az = np.where(sing, wrap_angle(np.arctan2(C[..., 1, 1], C[..., 0, 1]) - np.pi / 2), az)
+    az = np.where(
+        sing, wrap_angle(np.arctan2(C[..., 1, 1], C[..., 0, 1]) - np.pi / 2), az
+    )
     bk = np.where(sing, 0.0, bk)
     return Orientation(az, el, bk)
 
@@ -227,7 +233,9 @@ def angles_to_quaternion(azimuth, elevation, bank) -> np.ndarray:
 
     Closed form :math:`q = q_z(\theta)\otimes q_y(-\phi)\otimes q_x(\lambda)`.
     """
-    t, p, lam = np.broadcast_arrays(*(np.asarray(a, float) / 2 for a in (azimuth, elevation, bank)))
+    t, p, lam = np.broadcast_arrays(
+        *(np.asarray(a, float) / 2 for a in (azimuth, elevation, bank))
+    )
     ct, st = np.cos(t), np.sin(t)
     cp, sp = np.cos(p), -np.sin(p)  # rotation by -phi about y
     cl, sl = np.cos(lam), np.sin(lam)
@@ -247,18 +255,26 @@ def angles_from_quaternion(q, singular_tol: float = 1e-9) -> Orientation:
     return angles_from_matrix(_quat.to_matrix(q), singular_tol=singular_tol)
 
 
-def acc_from_angles(elevation, bank, g: float = 1.0, convention: Convention = "tiltlab") -> np.ndarray:
+def acc_from_angles(
+    elevation, bank, g: float = 1.0, convention: Convention = "tiltlab"
+) -> np.ndarray:
     r"""Static accelerometer reading of a body at rest with elevation φ and bank λ, shape (..., 3).
 
     Specific force (``"tiltlab"``): :math:`g\,C^\top e_z = g(\sin\phi, \cos\phi\sin\lambda, \cos\phi\cos\lambda)`;
     ``"benhamou"`` returns its negative.
     """
     p, lam = np.broadcast_arrays(np.asarray(elevation, float), np.asarray(bank, float))
-    f = g * np.stack([np.sin(p), np.cos(p) * np.sin(lam), np.cos(p) * np.cos(lam)], axis=-1)
+    f = g * np.stack(
+        [np.sin(p), np.cos(p) * np.sin(lam), np.cos(p) * np.cos(lam)], axis=-1
+    )
     return f if convention == "tiltlab" else _as_benhamou(f, "tiltlab")
 
 
-def geomagnetic_field(intensity: float = 48.0, inclination: float = np.radians(64.0), declination: float = 0.0) -> np.ndarray:
+def geomagnetic_field(
+    intensity: float = 48.0,
+    inclination: float = np.radians(64.0),
+    declination: float = 0.0,
+) -> np.ndarray:
     r"""Geomagnetic field in ENU coordinates.
 
     ``inclination`` is the dip angle, positive *downwards* (northern hemisphere),
@@ -266,7 +282,11 @@ def geomagnetic_field(intensity: float = 48.0, inclination: float = np.radians(6
     :math:`B(\cos I\sin D, \cos I\cos D, -\sin I)`.
     """
     return intensity * np.array(
-        [np.cos(inclination) * np.sin(declination), np.cos(inclination) * np.cos(declination), -np.sin(inclination)]
+        [
+            np.cos(inclination) * np.sin(declination),
+            np.cos(inclination) * np.cos(declination),
+            -np.sin(inclination),
+        ]
     )
 
 
@@ -277,14 +297,14 @@ def mag_from_angles(azimuth, elevation, bank, field=None) -> np.ndarray:
     return np.einsum("...ji,j->...i", C, m)
 
 
-
-
 # ---------------------------------------------------------------------------
 # device -> body (Eq. 1, App. A)
 # ---------------------------------------------------------------------------
 
 
-def mounting_angles(acc_rest, convention: Convention = "tiltlab") -> tuple[np.ndarray, np.ndarray]:
+def mounting_angles(
+    acc_rest, convention: Convention = "tiltlab"
+) -> tuple[np.ndarray, np.ndarray]:
     r"""Device mounting angles φ*, λ* from the acceleration recorded with the animal at rest and level.
 
     :math:`\phi^*=\sin^{-1}(-a^*_U/\|\mathbf a^*\|)`, :math:`\lambda^*=\mathrm{atan2}(-a^*_V,-a^*_W)` (§1),
@@ -300,13 +320,14 @@ def _elev_bank(A):
     return el, bk
 
 
-
 def mounting_matrix(phi_star, lambda_star, dtheta=0.0) -> np.ndarray:
     r"""Device→body matrix :math:`R_3(\Delta\theta)R_2(\phi^*)R_1(\lambda^*)` (App. A; Δθ = 0 gives Eq. 1)."""
     return R3(dtheta) @ R2(phi_star) @ R1(lambda_star)
 
 
-def device_to_body(vectors, phi_star, lambda_star, dtheta=0.0, rates: bool = False) -> np.ndarray:
+def device_to_body(
+    vectors, phi_star, lambda_star, dtheta=0.0, rates: bool = False
+) -> np.ndarray:
     r"""Express device-frame vectors in the body frame: :math:`\mathbf B^\top = R_3(\Delta\theta)R_2(\phi^*)R_1(\lambda^*)\mathbf D^\top`.
 
     Applies to (static) acceleration in either sign convention, calibrated magnetic
@@ -322,7 +343,9 @@ def device_to_body(vectors, phi_star, lambda_star, dtheta=0.0, rates: bool = Fal
     return gyro_to_body_rates(B) if rates else B
 
 
-def device_to_body_eq1(vectors, acc_rest, convention: Convention = "tiltlab") -> np.ndarray:
+def device_to_body_eq1(
+    vectors, acc_rest, convention: Convention = "tiltlab"
+) -> np.ndarray:
     r"""Eq. 1a–1c: explicit (matrix-free) device→body correction from the level-rest acceleration a*.
 
     .. math::
@@ -339,7 +362,9 @@ def device_to_body_eq1(vectors, acc_rest, convention: Convention = "tiltlab") ->
     aU, aV, aW = a[..., 0], a[..., 1], a[..., 2]
     s = np.hypot(aV, aW)
     if np.any(s == 0):
-        raise ValueError("acc_rest has no sway/heave component: the mounting bank angle is undefined")
+        raise ValueError(
+            "acc_rest has no sway/heave component: the mounting bank angle is undefined"
+        )
     n = np.sqrt(aU**2 + s**2)
     DU, DV, DW = D[..., 0], D[..., 1], D[..., 2]
     BU = (DU * s - aU * (DV * aV + DW * aW) / s) / n
@@ -380,7 +405,9 @@ def stage_angles(g) -> tuple[np.ndarray, np.ndarray]:
         raise ValueError(f"g must have last dimension 3, got {g.shape}")
     g = g / np.linalg.norm(g, axis=-1, keepdims=True)
     # atan2 form of beta = -asin(g_x): accurate near the poles too
-    return np.arctan2(-g[..., 0], np.hypot(g[..., 1], g[..., 2])), np.arctan2(g[..., 1], g[..., 2])
+    return np.arctan2(-g[..., 0], np.hypot(g[..., 1], g[..., 2])), np.arctan2(
+        g[..., 1], g[..., 2]
+    )
 
 
 def stage_quaternion(pitch, roll) -> np.ndarray:

@@ -43,7 +43,9 @@ class ReadError(OSError):
     """A file is missing, truncated, corrupt or not in the expected layout."""
 
 
-def _read_table(path: PathLike, required: Sequence[str], *, final_newline: bool = False, **kwargs) -> pd.DataFrame:
+def _read_table(
+    path: PathLike, required: Sequence[str], *, final_newline: bool = False, **kwargs
+) -> pd.DataFrame:
     path = Path(path)
     if not path.is_file():
         raise ReadError(f"{path}: no such file")
@@ -55,29 +57,44 @@ def _read_table(path: PathLike, required: Sequence[str], *, final_newline: bool 
                 raise ReadError(f"{path}: empty file")
             f.seek(-1, os.SEEK_END)
             if f.read(1) not in (b"\n", b"\r"):
-                raise ReadError(f"{path}: last line is incomplete (no final newline): truncated file?")
+                raise ReadError(
+                    f"{path}: last line is incomplete (no final newline): truncated file?"
+                )
     try:
         df = pd.read_csv(path, **kwargs)
-    except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError, ValueError) as exc:
+    except (
+        pd.errors.ParserError,
+        pd.errors.EmptyDataError,
+        UnicodeDecodeError,
+        ValueError,
+    ) as exc:
         raise ReadError(f"{path}: not a readable CSV table ({exc})") from None
     missing = [c for c in required if c not in df.columns]
     if missing:
-        raise ReadError(f"{path}: missing column(s) {missing}; found {list(df.columns)}")
+        raise ReadError(
+            f"{path}: missing column(s) {missing}; found {list(df.columns)}"
+        )
     sub = df[list(required)]
     numeric = sub.apply(pd.to_numeric, errors="coerce")
     bad = numeric.isna() & ~sub.isna()
     if bad.to_numpy().any():
         row, col = np.argwhere(bad.to_numpy())[0]
-        raise ReadError(f"{path}: non-numeric value {sub.iat[row, col]!r} in column {required[col]!r}, data row {row}")
+        raise ReadError(
+            f"{path}: non-numeric value {sub.iat[row, col]!r} in column {required[col]!r}, data row {row}"
+        )
     if numeric.isna().to_numpy().any():
         row, col = np.argwhere(numeric.isna().to_numpy())[0]
-        raise ReadError(f"{path}: empty field in column {required[col]!r}, data row {row} (truncated file?)")
+        raise ReadError(
+            f"{path}: empty field in column {required[col]!r}, data row {row} (truncated file?)"
+        )
     if len(numeric) < 2:
         raise ReadError(f"{path}: fewer than two samples")
     return numeric
 
 
-def read_fayat_imu(path: PathLike, *, counter_rate: float = 300.0, fs: float = 100.0, **attrs) -> xr.Dataset:
+def read_fayat_imu(
+    path: PathLike, *, counter_rate: float = 300.0, fs: float = 100.0, **attrs
+) -> xr.Dataset:
     """Read Fayat et al.'s freely-moving rat example (``example_imu.csv``).
 
     Columns ``counter, ax, ay, az, gx, gy, gz``: acceleration in g, angular velocity in
@@ -92,7 +109,9 @@ def read_fayat_imu(path: PathLike, *, counter_rate: float = 300.0, fs: float = 1
     ----------
     .. [1] R. Fayat et al., Sensors 21(18):6318, 2021. doi:10.3390/s21186318
     """
-    df = _read_table(path, ["counter", "ax", "ay", "az", "gx", "gy", "gz"], final_newline=True)
+    df = _read_table(
+        path, ["counter", "ax", "ay", "az", "gx", "gy", "gz"], final_newline=True
+    )
     counter = df["counter"].to_numpy(np.int64)
     time = (counter - counter[0]) / float(counter_rate)
     return schema.make_recording(
@@ -102,7 +121,13 @@ def read_fayat_imu(path: PathLike, *, counter_rate: float = 300.0, fs: float = 1
         acc_units="g",
         gyr_units="deg/s",
         time=time,
-        extra={"counter": ("time", counter, {"long_name": f"acquisition counter at {counter_rate:g} Hz"})},
+        extra={
+            "counter": (
+                "time",
+                counter,
+                {"long_name": f"acquisition counter at {counter_rate:g} Hz"},
+            )
+        },
         attrs={
             "source": str(Path(path).name),
             "sensor": "MPU9250 (wired head IMU)",
@@ -121,7 +146,12 @@ def read_fayat_tumble(path: PathLike, *, fs: float = 300.0, **attrs) -> xr.Datas
     300 Hz. The sensor is held still in several orientations; there is no trigger
     channel.
     """
-    df = _read_table(path, ["ax", "ay", "az", "gx", "gy", "gz", "time"], final_newline=True, index_col=0)
+    df = _read_table(
+        path,
+        ["ax", "ay", "az", "gx", "gy", "gz", "time"],
+        final_newline=True,
+        index_col=0,
+    )
     return schema.make_recording(
         df[["ax", "ay", "az"]].to_numpy(),
         df[["gx", "gy", "gz"]].to_numpy(),
@@ -129,7 +159,13 @@ def read_fayat_tumble(path: PathLike, *, fs: float = 300.0, **attrs) -> xr.Datas
         acc_units="g",
         gyr_units="deg/s",
         time=df["time"].to_numpy(),
-        attrs={"source": str(Path(path).name), "sensor": "MPU9250", "subject": "none", "session": "tumble test", **attrs},
+        attrs={
+            "source": str(Path(path).name),
+            "sensor": "MPU9250",
+            "subject": "none",
+            "session": "tumble test",
+            **attrs,
+        },
     )
 
 
@@ -156,7 +192,9 @@ def _read_broad_hdf5(path: Path) -> tuple[dict[str, np.ndarray], float, str]:
     except (OSError, KeyError) as exc:
         if isinstance(exc, ReadError):
             raise
-        raise ReadError(f"{path}: cannot read HDF5 file ({exc}); truncated or corrupt?") from None
+        raise ReadError(
+            f"{path}: cannot read HDF5 file ({exc}); truncated or corrupt?"
+        ) from None
     return data, fs, info
 
 
@@ -166,7 +204,9 @@ def _read_broad_mat(path: Path) -> tuple[dict[str, np.ndarray], float, str]:
     try:
         m = scipy.io.loadmat(path)
     except Exception as exc:  # scipy raises several types for damaged files
-        raise ReadError(f"{path}: cannot read MATLAB file ({type(exc).__name__}: {exc}); truncated or corrupt?") from None
+        raise ReadError(
+            f"{path}: cannot read MATLAB file ({type(exc).__name__}: {exc}); truncated or corrupt?"
+        ) from None
     missing = [k for k in _BROAD_VARS + ("sampling_rate",) if k not in m]
     if missing:
         raise ReadError(f"{path}: not a BROAD trial, missing {missing}")
@@ -200,11 +240,15 @@ def read_broad(path: PathLike, **attrs) -> xr.Dataset:
     elif suffix == ".mat":
         data, fs, info = _read_broad_mat(path)
     else:
-        raise ReadError(f"{path}: unknown BROAD file type {suffix!r} (expected .hdf5 or .mat)")
+        raise ReadError(
+            f"{path}: unknown BROAD file type {suffix!r} (expected .hdf5 or .mat)"
+        )
     n = data["imu_acc"].shape[0]
     for k in _BROAD_VARS:
         if data[k].shape[0] != n:
-            raise ReadError(f"{path}: {k} has {data[k].shape[0]} samples, imu_acc has {n}")
+            raise ReadError(
+                f"{path}: {k} has {data[k].shape[0]} samples, imu_acc has {n}"
+            )
     q = data["opt_quat"].astype(float)
     # the optical reference has NaN where tracking was lost; keep NaN, validate with allow_nan
     trial = path.stem
@@ -218,8 +262,16 @@ def read_broad(path: PathLike, **attrs) -> xr.Dataset:
         mag_units="uT",
         q_ref=q,
         extra={
-            "movement": ("time", data["movement"].astype(bool), {"long_name": "samples scored by BROAD (movement phase)"}),
-            "opt_pos": (("time", "axis"), data["opt_pos"].astype(float), {"units": "m", "long_name": "optical position", "frame": "world (ENU)"}),
+            "movement": (
+                "time",
+                data["movement"].astype(bool),
+                {"long_name": "samples scored by BROAD (movement phase)"},
+            ),
+            "opt_pos": (
+                ("time", "axis"),
+                data["opt_pos"].astype(float),
+                {"units": "m", "long_name": "optical position", "frame": "world (ENU)"},
+            ),
         },
         attrs={
             "source": path.name,
@@ -275,17 +327,25 @@ def read_csv(
             raise ValueError(f"columns must map {k!r}")
     for k in cols:
         if k not in ("acc", "gyr", "mag", "temp", "q_ref"):
-            raise ValueError(f"unknown variable {k!r} in columns (acc, gyr, mag, temp, q_ref)")
+            raise ValueError(
+                f"unknown variable {k!r} in columns (acc, gyr, mag, temp, q_ref)"
+            )
         if k != "q_ref" and k not in units:
-            raise ValueError(f"units must give the unit of {k!r}; tiltlab does not assume one")
-    required = [c for v in cols.values() for c in v] + ([time_column] if time_column else [])
+            raise ValueError(
+                f"units must give the unit of {k!r}; tiltlab does not assume one"
+            )
+    required = [c for v in cols.values() for c in v] + (
+        [time_column] if time_column else []
+    )
     df = _read_table(path, required, **read_kwargs)
     get = {k: df[v].to_numpy(float) for k, v in cols.items()}
     time = df[time_column].to_numpy(float) * time_scale if time_column else None
     extra_attrs = dict(attrs or {})
     if fs is None:
         if time is None:
-            raise ValueError("give fs, or a time_column from which to estimate it; tiltlab never assumes a sampling rate")
+            raise ValueError(
+                "give fs, or a time_column from which to estimate it; tiltlab never assumes a sampling rate"
+            )
         fs = 1.0 / float(np.median(np.diff(time)))
         extra_attrs["fs_source"] = f"estimated from column {time_column!r}"
     return schema.make_recording(
@@ -312,7 +372,9 @@ def _json_default(o):
         return o.item()
     if isinstance(o, np.ndarray):
         return {"__ndarray__": o.tolist(), "dtype": str(o.dtype)}
-    raise TypeError(f"attribute value {o!r} of type {type(o).__name__} cannot be stored")
+    raise TypeError(
+        f"attribute value {o!r} of type {type(o).__name__} cannot be stored"
+    )
 
 
 def _json_hook(d):
@@ -336,16 +398,26 @@ def save_netcdf(ds: xr.Dataset, path: PathLike) -> Path:
         blob = json.dumps(record, default=_json_default)
     except TypeError as exc:
         raise ValueError(f"cannot save attributes: {exc}") from None
-    out.attrs = {k: v for k, v in ds.attrs.items() if isinstance(v, (str, int, float, np.number)) and not isinstance(v, bool)}
+    out.attrs = {
+        k: v
+        for k, v in ds.attrs.items()
+        if isinstance(v, (str, int, float, np.number)) and not isinstance(v, bool)
+    }
     out.attrs[_ATTRS_KEY] = blob
     for name in out.variables:
-        out[name].attrs = {k: v for k, v in ds[name].attrs.items() if isinstance(v, (str, int, float, np.number)) and not isinstance(v, bool)}
+        out[name].attrs = {
+            k: v
+            for k, v in ds[name].attrs.items()
+            if isinstance(v, (str, int, float, np.number)) and not isinstance(v, bool)
+        }
     path.parent.mkdir(parents=True, exist_ok=True)
     out.to_netcdf(path, engine="h5netcdf", invalid_netcdf=False)
     return path
 
 
-def load_netcdf(path: PathLike, *, validate: bool = False, **validate_kwargs) -> xr.Dataset:
+def load_netcdf(
+    path: PathLike, *, validate: bool = False, **validate_kwargs
+) -> xr.Dataset:
     """Load a Dataset written by :func:`save_netcdf` (fully into memory).
 
     Parameters
@@ -363,7 +435,9 @@ def load_netcdf(path: PathLike, *, validate: bool = False, **validate_kwargs) ->
         with xr.open_dataset(path, engine="h5netcdf") as f:
             ds = f.load()
     except Exception as exc:
-        raise ReadError(f"{path}: cannot read NetCDF file ({type(exc).__name__}: {exc}); truncated or corrupt?") from None
+        raise ReadError(
+            f"{path}: cannot read NetCDF file ({type(exc).__name__}: {exc}); truncated or corrupt?"
+        ) from None
     blob = ds.attrs.pop(_ATTRS_KEY, None)
     if blob is not None:
         record = json.loads(blob, object_hook=_json_hook)
@@ -374,6 +448,10 @@ def load_netcdf(path: PathLike, *, validate: bool = False, **validate_kwargs) ->
     for name in ds.variables:
         ds[name].encoding = {}
     if validate:
-        allow_nan = any(bool(np.isnan(ds[v].values).any()) for v in ds.data_vars if ds[v].dtype.kind == "f")
+        allow_nan = any(
+            bool(np.isnan(ds[v].values).any())
+            for v in ds.data_vars
+            if ds[v].dtype.kind == "f"
+        )
         schema.validate(ds, **{"allow_nan": allow_nan, **validate_kwargs})
     return ds

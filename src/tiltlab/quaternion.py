@@ -104,7 +104,11 @@ def rotate_scalar(w, x, y, z, vx, vy, vz):
     tx = 2.0 * (y * vz - z * vy)
     ty = 2.0 * (z * vx - x * vz)
     tz = 2.0 * (x * vy - y * vx)
-    return vx + w * tx + (y * tz - z * ty), vy + w * ty + (z * tx - x * tz), vz + w * tz + (x * ty - y * tx)
+    return (
+        vx + w * tx + (y * tz - z * ty),
+        vy + w * ty + (z * tx - x * tz),
+        vz + w * tz + (x * ty - y * tx),
+    )
 
 
 # ---------------------------------------------------------------- kernels
@@ -125,7 +129,9 @@ def _rotate_kernel(q, v, inverse, out):
         w, x, y, z = q[i, 0], q[i, 1], q[i, 2], q[i, 3]
         if inverse:
             x, y, z = -x, -y, -z
-        out[i, 0], out[i, 1], out[i, 2] = rotate_scalar(w, x, y, z, v[i, 0], v[i, 1], v[i, 2])
+        out[i, 0], out[i, 1], out[i, 2] = rotate_scalar(
+            w, x, y, z, v[i, 0], v[i, 1], v[i, 2]
+        )
 
 
 @njit(cache=True)
@@ -205,7 +211,9 @@ def _to_rotvec_kernel(q, out):
 @njit(cache=True)
 def _from_rotvec_kernel(r, out):
     for i in range(r.shape[0]):
-        out[i, 0], out[i, 1], out[i, 2], out[i, 3] = rotvec_to_quat_scalar(r[i, 0], r[i, 1], r[i, 2])
+        out[i, 0], out[i, 1], out[i, 2], out[i, 3] = rotvec_to_quat_scalar(
+            r[i, 0], r[i, 1], r[i, 2]
+        )
 
 
 @njit(cache=True)
@@ -221,7 +229,9 @@ def _gravity_kernel(q, out):
 def _error_angles_kernel(p, q, out):
     # columns: total, heading, inclination of the Earth-frame error e = p ⊗ q⁻¹
     for i in range(p.shape[0]):
-        w, x, y, z = qmul_scalar(p[i, 0], p[i, 1], p[i, 2], p[i, 3], q[i, 0], -q[i, 1], -q[i, 2], -q[i, 3])
+        w, x, y, z = qmul_scalar(
+            p[i, 0], p[i, 1], p[i, 2], p[i, 3], q[i, 0], -q[i, 1], -q[i, 2], -q[i, 3]
+        )
         aw = abs(w)
         out[i, 0] = 2.0 * np.arctan2(np.sqrt(x * x + y * y + z * z), aw)
         if aw == 0.0 and z == 0.0:
@@ -247,7 +257,9 @@ def _integrate_kernel(omega, dt, q0, out):
     w, x, y, z = q0[0], q0[1], q0[2], q0[3]
     out[0, 0], out[0, 1], out[0, 2], out[0, 3] = w, x, y, z
     for k in range(omega.shape[0] - 1):
-        nw, nx, ny, nz = zoh_step_scalar(w, x, y, z, omega[k, 0] * dt, omega[k, 1] * dt, omega[k, 2] * dt)
+        nw, nx, ny, nz = zoh_step_scalar(
+            w, x, y, z, omega[k, 0] * dt, omega[k, 1] * dt, omega[k, 2] * dt
+        )
         n = np.sqrt(nw * nw + nx * nx + ny * ny + nz * nz)
         w, x, y, z = nw / n, nx / n, ny / n, nz / n
         out[k + 1, 0], out[k + 1, 1], out[k + 1, 2], out[k + 1, 3] = w, x, y, z
@@ -262,7 +274,9 @@ def _as2d(a: np.ndarray, width: int) -> np.ndarray:
 
 def _check_last(a: np.ndarray, width: int, name: str) -> None:
     if a.ndim == 0 or a.shape[-1] != width:
-        raise ValueError(f"{name} must have last dimension {width}, got shape {a.shape}")
+        raise ValueError(
+            f"{name} must have last dimension {width}, got shape {a.shape}"
+        )
 
 
 def identity(n: int | None = None) -> np.ndarray:
@@ -416,7 +430,11 @@ def angle_between(u, v) -> np.ndarray:
     _check_last(v, 3, "v")
     lead = np.broadcast_shapes(u.shape[:-1], v.shape[:-1])
     out = np.empty(int(np.prod(lead, dtype=np.int64)))
-    _angle_between_kernel(_as2d(np.broadcast_to(u, lead + (3,)), 3), _as2d(np.broadcast_to(v, lead + (3,)), 3), out)
+    _angle_between_kernel(
+        _as2d(np.broadcast_to(u, lead + (3,)), 3),
+        _as2d(np.broadcast_to(v, lead + (3,)), 3),
+        out,
+    )
     return out.reshape(lead)
 
 
@@ -509,12 +527,19 @@ def to_scipy(q):
     return Rotation.from_quat(np.asarray(q, float), scalar_first=True)
 
 
-def random_quaternions(n: int, rng: np.random.Generator | int | None = None) -> np.ndarray:
+def random_quaternions(
+    n: int, rng: np.random.Generator | int | None = None
+) -> np.ndarray:
     """``n`` uniformly distributed unit quaternions (Shoemake's method), w ≥ 0."""
     rng = np.random.default_rng(rng)
     u1, u2, u3 = rng.random((3, n))
     a, b = np.sqrt(1.0 - u1), np.sqrt(u1)
     q = np.column_stack(
-        [a * np.sin(2 * np.pi * u2), a * np.cos(2 * np.pi * u2), b * np.sin(2 * np.pi * u3), b * np.cos(2 * np.pi * u3)]
+        [
+            a * np.sin(2 * np.pi * u2),
+            a * np.cos(2 * np.pi * u2),
+            b * np.sin(2 * np.pi * u3),
+            b * np.cos(2 * np.pi * u3),
+        ]
     )
     return canonical(q)

@@ -52,8 +52,6 @@ _QUANTITY = {**VECTOR_VARS, "temp": "temperature", "q_ref": "dimensionless"}
 _PROVENANCE = ("source", "sensor", "subject", "session")
 
 
-
-
 def make_recording(
     acc,
     gyr,
@@ -108,7 +106,9 @@ def make_recording(
         The Recording.
     """
     if fs is None:
-        raise RecordingError("fs (sampling rate, Hz) is mandatory; tiltlab never assumes a default")
+        raise RecordingError(
+            "fs (sampling rate, Hz) is mandatory; tiltlab never assumes a default"
+        )
     fs = float(fs)
     if not np.isfinite(fs) or fs <= 0:
         raise RecordingError(f"fs must be a positive finite number of Hz, got {fs!r}")
@@ -130,27 +130,72 @@ def make_recording(
         raise RecordingError(f"time must have shape ({n},), got {time.shape}")
 
     data_vars: dict[str, Any] = {
-        "acc": (("time", "axis"), acc.copy(), {"units": _units.normalise_unit(acc_units), "long_name": "acceleration (specific force)"}),
-        "gyr": (("time", "axis"), gyr.copy(), {"units": _units.normalise_unit(gyr_units), "long_name": "angular velocity"}),
+        "acc": (
+            ("time", "axis"),
+            acc.copy(),
+            {
+                "units": _units.normalise_unit(acc_units),
+                "long_name": "acceleration (specific force)",
+            },
+        ),
+        "gyr": (
+            ("time", "axis"),
+            gyr.copy(),
+            {
+                "units": _units.normalise_unit(gyr_units),
+                "long_name": "angular velocity",
+            },
+        ),
     }
     if mag is not None:
-        data_vars["mag"] = (("time", "axis"), np.array(mag, dtype=float), {"units": _units.normalise_unit(mag_units), "long_name": "magnetic field"})
+        data_vars["mag"] = (
+            ("time", "axis"),
+            np.array(mag, dtype=float),
+            {"units": _units.normalise_unit(mag_units), "long_name": "magnetic field"},
+        )
     if temp is not None:
-        data_vars["temp"] = (("time",), np.array(temp, dtype=float), {"units": _units.normalise_unit(temp_units), "long_name": "sensor temperature"})
+        data_vars["temp"] = (
+            ("time",),
+            np.array(temp, dtype=float),
+            {
+                "units": _units.normalise_unit(temp_units),
+                "long_name": "sensor temperature",
+            },
+        )
     if q_ref is not None:
-        data_vars["q_ref"] = (("time", "quat"), np.array(q_ref, dtype=float), {"units": "1", "long_name": "reference orientation, sensor to world", "frame": "sensor->world"})
+        data_vars["q_ref"] = (
+            ("time", "quat"),
+            np.array(q_ref, dtype=float),
+            {
+                "units": "1",
+                "long_name": "reference orientation, sensor to world",
+                "frame": "sensor->world",
+            },
+        )
     for name, value in (extra or {}).items():
         if isinstance(value, tuple):
             data_vars[name] = value
         else:
             arr = np.array(value)
-            dims = ("time",) if arr.ndim == 1 else ("time", "axis") if arr.shape[1:] == (3,) else None
+            dims = (
+                ("time",)
+                if arr.ndim == 1
+                else ("time", "axis")
+                if arr.shape[1:] == (3,)
+                else None
+            )
             if dims is None:
-                raise RecordingError(f"extra variable {name!r}: give (dims, array, attrs) for shape {arr.shape}")
+                raise RecordingError(
+                    f"extra variable {name!r}: give (dims, array, attrs) for shape {arr.shape}"
+                )
             data_vars[name] = (dims, arr)
     ds = xr.Dataset(
         data_vars,
-        coords={"time": ("time", time, {"units": "s"}), "axis": list(AXES), **({"quat": list(QUAT)} if q_ref is not None else {})},
+        coords={
+            "time": ("time", time, {"units": "s"}),
+            "axis": list(AXES),
+            **({"quat": list(QUAT)} if q_ref is not None else {}),
+        },
         attrs={"fs": fs, "frame": frame, **dict(attrs or {})},
     )
     if validate_result:
@@ -176,7 +221,11 @@ def _check_finite(da: xr.DataArray, name: str, allow_nan: bool) -> None:
         idx = np.argwhere(bad)[0]
         raise RecordingError(
             f"{name!r} has {int(bad.sum())} non-finite values (first at index {tuple(int(i) for i in idx)})"
-            + ("" if allow_nan else "; NaN is not allowed here (pass allow_nan=True to accept gaps)")
+            + (
+                ""
+                if allow_nan
+                else "; NaN is not allowed here (pass allow_nan=True to accept gaps)"
+            )
         )
 
 
@@ -232,14 +281,20 @@ def validate(
         With a message naming the first problem found.
     """
     if not isinstance(ds, xr.Dataset):
-        raise RecordingError(f"a Recording is an xarray.Dataset, got {type(ds).__name__}")
+        raise RecordingError(
+            f"a Recording is an xarray.Dataset, got {type(ds).__name__}"
+        )
     fs = ds.attrs.get("fs")
     if fs is None:
-        raise RecordingError("attribute 'fs' (sampling rate, Hz) is missing; it is mandatory")
+        raise RecordingError(
+            "attribute 'fs' (sampling rate, Hz) is missing; it is mandatory"
+        )
     try:
         fs = float(fs)
     except (TypeError, ValueError):
-        raise RecordingError(f"attribute 'fs' must be a number of Hz, got {fs!r}") from None
+        raise RecordingError(
+            f"attribute 'fs' must be a number of Hz, got {fs!r}"
+        ) from None
     if not np.isfinite(fs) or fs <= 0:
         raise RecordingError(f"attribute 'fs' must be positive and finite, got {fs!r}")
     if "frame" not in ds.attrs:
@@ -264,7 +319,9 @@ def validate(
         dt = np.diff(t)
         if np.any(dt <= 0):
             i = int(np.argmax(dt <= 0))
-            raise RecordingError(f"time is not strictly increasing (at sample {i + 1}: {t[i]} → {t[i + 1]} s)")
+            raise RecordingError(
+                f"time is not strictly increasing (at sample {i + 1}: {t[i]} → {t[i + 1]} s)"
+            )
         jitter = np.abs(dt * fs - 1.0)
         if jitter.max() > max_jitter:
             i = int(np.argmax(jitter))
@@ -274,7 +331,9 @@ def validate(
                 "a dropped or duplicated sample, or a wrong fs"
             )
     if ds["time"].attrs.get("units", "s") != "s":
-        raise RecordingError(f"coordinate 'time' must be in seconds, got units {ds['time'].attrs['units']!r}")
+        raise RecordingError(
+            f"coordinate 'time' must be in seconds, got units {ds['time'].attrs['units']!r}"
+        )
 
     for name in VECTOR_VARS:
         if name in ds:
@@ -282,13 +341,17 @@ def validate(
             _check_units(ds[name], name)
     if "temp" in ds:
         if ds["temp"].dims != ("time",):
-            raise RecordingError(f"'temp' must have dims ('time',), got {ds['temp'].dims}")
+            raise RecordingError(
+                f"'temp' must have dims ('time',), got {ds['temp'].dims}"
+            )
         _check_finite(ds["temp"], "temp", allow_nan)
         _check_units(ds["temp"], "temp")
     if "q_ref" in ds:
         q = ds["q_ref"]
         if q.dims != ("time", "quat"):
-            raise RecordingError(f"'q_ref' must have dims ('time', 'quat'), got {q.dims}")
+            raise RecordingError(
+                f"'q_ref' must have dims ('time', 'quat'), got {q.dims}"
+            )
         if tuple(str(c) for c in ds["quat"].values) != QUAT:
             raise RecordingError(f"coordinate 'quat' must be {QUAT} (scalar first)")
         _check_finite(q, "q_ref", allow_nan)
@@ -304,7 +367,9 @@ def validate(
             )
     for name, da in ds.data_vars.items():
         if "time" in da.dims and da.dims[0] != "time":
-            raise RecordingError(f"variable {name!r}: 'time' must be the first dimension, got {da.dims}")
+            raise RecordingError(
+                f"variable {name!r}: 'time' must be the first dimension, got {da.dims}"
+            )
 
     if check_units:
         acc = np.asarray(ds["acc"].values, dtype=float)
@@ -353,7 +418,8 @@ def describe(ds: xr.Dataset) -> dict[str, Any]:
     """
     t = ds["time"].values
     variables = ", ".join(
-        f"{v} [{ds[v].attrs['units']}]" if "units" in ds[v].attrs else str(v) for v in ds.data_vars
+        f"{v} [{ds[v].attrs['units']}]" if "units" in ds[v].attrs else str(v)
+        for v in ds.data_vars
     )
     missing = None
     if "q_ref" in ds:
@@ -361,7 +427,9 @@ def describe(ds: xr.Dataset) -> dict[str, Any]:
     return {
         "session": ds.attrs.get("session"),
         "samples": int(ds.sizes["time"]),
-        "duration_s": float(t[-1] - t[0] + 1.0 / float(ds.attrs["fs"])) if t.size else 0.0,
+        "duration_s": float(t[-1] - t[0] + 1.0 / float(ds.attrs["fs"]))
+        if t.size
+        else 0.0,
         "fs_hz": float(ds.attrs["fs"]),
         "variables": variables,
         "missing_q_ref": missing,

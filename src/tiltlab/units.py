@@ -123,7 +123,9 @@ def conversion_factor(src: str, dst: str) -> float:
     if s == d:
         return 1.0
     if quantity_of(s) != quantity_of(d):
-        raise UnitsError(f"cannot convert {src!r} ({quantity_of(s)}) to {dst!r} ({quantity_of(d)})")
+        raise UnitsError(
+            f"cannot convert {src!r} ({quantity_of(s)}) to {dst!r} ({quantity_of(d)})"
+        )
     if s not in _TO_BASE or d not in _TO_BASE:
         raise UnitsError(f"no multiplicative conversion between {src!r} and {dst!r}")
     return _TO_BASE[s] / _TO_BASE[d]

@@ -41,6 +41,7 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from ..frames import fibonacci_lattice, stage_angles, stage_quaternion
+from .. import _validate as _v
 from ._util import CalibrationError, mat3, vec3
 
 __all__ = [
@@ -63,16 +64,27 @@ __all__ = [
     "orientation_count_study",
 ]
 
-def _points(points, radius, name="points", min_n=1, max_norm_deviation=0.25) -> np.ndarray:
+
+def _points(
+    points, radius, name="points", min_n=1, max_norm_deviation=0.25
+) -> np.ndarray:
     p = vec3(points, name, ndim=2)
+    radius = _v.positive(radius, "radius")
+    max_norm_deviation = _v.positive(
+        max_norm_deviation, "max_norm_deviation", allow_inf=True
+    )
     if p.shape[0] < min_n:
-        raise CalibrationError(f"{p.shape[0]} static poses given, at least {min_n} are needed for this fit")
+        raise CalibrationError(
+            f"{p.shape[0]} static poses given, at least {min_n} are needed for this fit"
+        )
     nrm = np.linalg.norm(p, axis=1)
     bad = np.abs(nrm / radius - 1.0) > max_norm_deviation
     if np.any(bad):
         k = int(np.flatnonzero(bad)[0])
-        raise CalibrationError(f"static pose {k} has norm {nrm[k]:.4g}, more than {100 * max_norm_deviation:.0f} % "
-                               f"away from {radius:g}: saturated, moving, or wrong units")
+        raise CalibrationError(
+            f"static pose {k} has norm {nrm[k]:.4g}, more than {100 * max_norm_deviation:.0f} % "
+            f"away from {radius:g}: saturated, moving, or wrong units"
+        )
     return p
 
 
@@ -82,15 +94,17 @@ def norm_error(points, offset=None, matrix=None, radius: float = 1.0) -> np.ndar
     d = p - (0.0 if offset is None else vec3(offset, "offset", ndim=1))
     if matrix is not None:
         d = d @ mat3(matrix, "matrix").T
-    return np.linalg.norm(d, axis=-1) - radius
+    return np.linalg.norm(d, axis=-1) - _v.positive(radius, "radius")
 
 
 def _condition_or_raise(J, what, max_condition):
     s = np.linalg.svd(J, compute_uv=False)
     cond = np.inf if s[-1] <= 0 else s[0] / s[-1]
     if not np.isfinite(cond) or cond > max_condition:
-        raise CalibrationError(f"the static orientations do not determine the {what} (condition number {cond:.3g} > "
-                               f"{max_condition:g}): orientations are collinear/coplanar or too few")
+        raise CalibrationError(
+            f"the static orientations do not determine the {what} (condition number {cond:.3g} > "
+            f"{max_condition:g}): orientations are collinear/coplanar or too few"
+        )
     return cond
 
 
@@ -108,8 +122,15 @@ class OffsetFit(NamedTuple):
     n: int
 
 
-def fit_offsets(points, *, sem=None, radius: float = 1.0, x0=None, max_condition: float = 1e3,
-                max_norm_deviation: float = 0.25) -> OffsetFit:
+def fit_offsets(
+    points,
+    *,
+    sem=None,
+    radius: float = 1.0,
+    x0=None,
+    max_condition: float = 1e3,
+    max_norm_deviation: float = 0.25,
+) -> OffsetFit:
     r"""Accelerometer offsets by Fayat's criterion, :math:`\arg\min_o \frac1P\sum_p(r - \|a_p - o\|)^2`.
 
     Parameters
@@ -141,6 +162,7 @@ def fit_offsets(points, *, sem=None, radius: float = 1.0, x0=None, max_condition
     :math:`s^2 (J^\top J)^{-1}` with the residual variance :math:`s^2` otherwise.
     """
     p = _points(points, radius, min_n=3, max_norm_deviation=max_norm_deviation)
+    max_condition = _v.positive(max_condition, "max_condition")
     x0 = np.zeros(3) if x0 is None else vec3(x0, "x0", ndim=1)
     w = np.ones(p.shape[0])
     if sem is not None:
@@ -151,7 +173,9 @@ def fit_offsets(points, *, sem=None, radius: float = 1.0, x0=None, max_condition
     def resid(o):
         return (np.linalg.norm(p - o, axis=1) - radius) * w
 
-    sol = least_squares(resid, x0, method="lm" if p.shape[0] >= 3 else "trf", xtol=1e-14, ftol=1e-14)
+    sol = least_squares(
+        resid, x0, method="lm" if p.shape[0] >= 3 else "trf", xtol=1e-14, ftol=1e-14
+    )
     o = sol.x
     u = (p - o) / np.linalg.norm(p - o, axis=1, keepdims=True)
     J = -u
@@ -165,10 +189,20 @@ def fit_offsets(points, *, sem=None, radius: float = 1.0, x0=None, max_condition
         cov = s2 * np.linalg.inv(J.T @ J)
     else:
         cov = np.full((3, 3), np.nan)
-    return OffsetFit(o, np.sqrt(np.diag(cov)), cov, r, float(np.mean(np.abs(r))), float(cond), p.shape[0])
+    return OffsetFit(
+        o,
+        np.sqrt(np.diag(cov)),
+        cov,
+        r,
+        float(np.mean(np.abs(r))),
+        float(cond),
+        p.shape[0],
+    )
 
 
-def fit_offsets_batch(points, *, radius: float = 1.0, iterations: int = 30, damping: float = 1e-9) -> np.ndarray:
+def fit_offsets_batch(
+    points, *, radius: float = 1.0, iterations: int = 30, damping: float = 1e-9
+) -> np.ndarray:
     r"""Fayat offset fits for many small sets of poses at once (vectorised Gauss–Newton).
 
     Parameters
@@ -183,6 +217,9 @@ def fit_offsets_batch(points, *, radius: float = 1.0, iterations: int = 30, damp
         Offsets; used for subset studies (Fayat Fig. 1c) where thousands of fits are needed.
     """
     p = vec3(points, "points", ndim=3)
+    radius = _v.positive(radius, "radius")
+    iterations = _v.integer(iterations, "iterations", minimum=1)
+    damping = _v.nonnegative(damping, "damping")
     o = np.zeros((p.shape[0], 3))
     eye = np.eye(3)
     for _ in range(iterations):
@@ -250,7 +287,20 @@ def _algebraic_quadric(p):
     s = np.sqrt(np.mean(np.sum((p - m) ** 2, axis=1)))
     y = (p - m) / s
     x, yy, z = y.T
-    D = np.column_stack([x * x, yy * yy, z * z, 2 * x * yy, 2 * x * z, 2 * yy * z, 2 * x, 2 * yy, 2 * z, np.ones_like(x)])
+    D = np.column_stack(
+        [
+            x * x,
+            yy * yy,
+            z * z,
+            2 * x * yy,
+            2 * x * z,
+            2 * yy * z,
+            2 * x,
+            2 * yy,
+            2 * z,
+            np.ones_like(x),
+        ]
+    )
     _, sv, Vt = np.linalg.svd(D, full_matrices=False)
     v = Vt[-1]
     A = np.array([[v[0], v[3], v[4]], [v[3], v[1], v[5]], [v[4], v[5], v[2]]])
@@ -259,8 +309,15 @@ def _algebraic_quadric(p):
     return A, b, c, m, s, sv
 
 
-def fit_ellipsoid(points, *, radius: float = 1.0, sem=None, structure: str = "triangular",
-                  max_condition: float = 1e4, max_norm_deviation: float = 0.25) -> EllipsoidFit:
+def fit_ellipsoid(
+    points,
+    *,
+    radius: float = 1.0,
+    sem=None,
+    structure: str = "triangular",
+    max_condition: float = 1e4,
+    max_norm_deviation: float = 0.25,
+) -> EllipsoidFit:
     r"""Nine-parameter ellipsoid fit :math:`\|C(y_p - o)\| = r` (offsets, scales, misalignment).
 
     Parameters
@@ -291,22 +348,31 @@ def fit_ellipsoid(points, *, radius: float = 1.0, sem=None, structure: str = "tr
     :func:`scipy.optimize.least_squares` (LM) minimises the geometric residuals.
     """
     if structure not in ("triangular", "symmetric"):
-        raise ValueError(f"structure must be 'triangular' or 'symmetric', got {structure!r}")
+        raise ValueError(
+            f"structure must be 'triangular' or 'symmetric', got {structure!r}"
+        )
     p = _points(points, radius, min_n=9, max_norm_deviation=max_norm_deviation)
+    max_condition = _v.positive(max_condition, "max_condition")
     A, b, c, m, s, sv = _algebraic_quadric(p)
     # second-smallest singular value small -> the quadric is not unique (poses too few/degenerate)
     if sv.size < 10 or sv[-2] / sv[0] < 1.0 / max_condition:
-        raise CalibrationError("the static orientations do not determine a 9-parameter ellipsoid: "
-                               "they are too few or lie on a plane/cone (use fit_offsets instead)")
+        raise CalibrationError(
+            "the static orientations do not determine a 9-parameter ellipsoid: "
+            "they are too few or lie on a plane/cone (use fit_offsets instead)"
+        )
     try:
         o_n = -0.5 * np.linalg.solve(A, b)
     except np.linalg.LinAlgError as e:
-        raise CalibrationError("degenerate quadric: orientations do not determine an ellipsoid") from e
+        raise CalibrationError(
+            "degenerate quadric: orientations do not determine an ellipsoid"
+        ) from e
     k = o_n @ A @ o_n - c
     M = A / k
     ev = np.linalg.eigvalsh(M)
     if np.any(ev <= 0):
-        raise CalibrationError("the fitted quadric is not an ellipsoid (orientations too poorly spread)")
+        raise CalibrationError(
+            "the fitted quadric is not an ellipsoid (orientations too poorly spread)"
+        )
     M = M / s**2  # back to original units
     o = m + s * o_n
     if structure == "triangular":
@@ -323,7 +389,9 @@ def fit_ellipsoid(points, *, radius: float = 1.0, sem=None, structure: str = "tr
             raise ValueError("sem must have the same shape as points")
 
     def resid(v):
-        return np.linalg.norm((p - v[:3]) @ _c_from(v[3:], structure).T, axis=1) - radius
+        return (
+            np.linalg.norm((p - v[:3]) @ _c_from(v[3:], structure).T, axis=1) - radius
+        )
 
     def jac(v):
         o_, C = v[:3], _c_from(v[3:], structure)
@@ -348,8 +416,14 @@ def fit_ellipsoid(points, *, radius: float = 1.0, sem=None, structure: str = "tr
         gp = u0 @ Cs  # d r_p / d y_p
         var = np.sum(gp * gp * se * se, axis=1)
         wts = 1.0 / np.sqrt(var)
-        sol = least_squares(lambda v: resid(v) * wts, sol0.x, jac=lambda v: jac(v) * wts[:, None], method="lm",
-                            xtol=1e-15, ftol=1e-15)
+        sol = least_squares(
+            lambda v: resid(v) * wts,
+            sol0.x,
+            jac=lambda v: jac(v) * wts[:, None],
+            method="lm",
+            xtol=1e-15,
+            ftol=1e-15,
+        )
     else:
         sol = least_squares(resid, v0, jac=jac, method="lm", xtol=1e-15, ftol=1e-15)
     v = sol.x
@@ -369,8 +443,20 @@ def fit_ellipsoid(points, *, radius: float = 1.0, sem=None, structure: str = "tr
     Cse = _c_from(se_v[3:], structure)
     if structure == "triangular":
         Cse = np.triu(Cse)
-    return EllipsoidFit(v[:3].copy(), C, v, se_v, se_v[:3], Cse, cov, r, float(np.mean(np.abs(r))), float(cond),
-                        structure, p.shape[0])
+    return EllipsoidFit(
+        v[:3].copy(),
+        C,
+        v,
+        se_v,
+        se_v[:3],
+        Cse,
+        cov,
+        r,
+        float(np.mean(np.abs(r))),
+        float(cond),
+        structure,
+        p.shape[0],
+    )
 
 
 class LinearFit(NamedTuple):
@@ -387,7 +473,9 @@ class LinearFit(NamedTuple):
     n: int
 
 
-def fit_known_directions(points, directions, *, max_condition: float = 1e3) -> LinearFit:
+def fit_known_directions(
+    points, directions, *, max_condition: float = 1e3
+) -> LinearFit:
     r"""Twelve-parameter calibration :math:`y_p = T g_p + o` when the true unit directions are known.
 
     Each axis i is an ordinary least-squares regression of :math:`y_{p,i}` on
@@ -396,10 +484,13 @@ def fit_known_directions(points, directions, *, max_condition: float = 1e3) -> L
     """
     y = vec3(points, "points", ndim=2)
     g = vec3(directions, "directions", ndim=2)
+    max_condition = _v.positive(max_condition, "max_condition")
     if g.shape != y.shape:
         raise ValueError("points and directions must have the same shape")
     if y.shape[0] < 4:
-        raise CalibrationError(f"{y.shape[0]} poses given, at least 4 non-coplanar ones are needed for 12 parameters")
+        raise CalibrationError(
+            f"{y.shape[0]} poses given, at least 4 non-coplanar ones are needed for 12 parameters"
+        )
     X = np.column_stack([g, np.ones(y.shape[0])])
     _condition_or_raise(X, "12-parameter linear model", max_condition)
     beta, *_ = np.linalg.lstsq(X, y, rcond=None)  # (4, 3): rows gx, gy, gz, 1
@@ -427,8 +518,9 @@ def lattice_subset(directions, k: int) -> np.ndarray:
     """Indices of ``k`` of the given directions best matching a k-point Fibonacci lattice
     (greedy nearest neighbour, each direction used once; Fayat Fig. 1c for N ≥ 5)."""
     d = vec3(directions, "directions", ndim=2)
-    if not 1 <= k <= d.shape[0]:
-        raise ValueError(f"k must be between 1 and {d.shape[0]}")
+    k = _v.integer(k, "k", minimum=1)
+    if k > d.shape[0]:
+        raise ValueError(f"k must be between 1 and {d.shape[0]}, got {k}")
     target = fibonacci_lattice(k)
     free = np.ones(d.shape[0], bool)
     out = []
@@ -447,19 +539,34 @@ def triplet_orthogonality(directions) -> np.ndarray:
     return np.abs(np.linalg.det(u))
 
 
-def all_subsets(n: int, k: int, *, max_subsets: int | None = None, rng=None) -> np.ndarray:
+def all_subsets(
+    n: int, k: int, *, max_subsets: int | None = None, rng=None
+) -> np.ndarray:
     """All k-subsets of range(n) as an int array (S, k), or ``max_subsets`` of them drawn at random."""
     from math import comb
 
+    n = _v.integer(n, "n", minimum=0)
+    k = _v.integer(k, "k", minimum=0)
+    if max_subsets is not None:
+        max_subsets = _v.integer(max_subsets, "max_subsets", minimum=1)
     total = comb(n, k)
     if max_subsets is None or total <= max_subsets:
         return np.array(list(combinations(range(n), k)), dtype=np.int64).reshape(-1, k)
     rng = np.random.default_rng(rng)
-    return np.sort(np.array([rng.choice(n, k, replace=False) for _ in range(max_subsets)]), axis=1)
+    return np.sort(
+        np.array([rng.choice(n, k, replace=False) for _ in range(max_subsets)]), axis=1
+    )
 
 
-def offset_systematic_uncertainty(points, *, scale_sd: float = 0.01, misalign_sd: float = 0.005, n_draws: int = 2000,
-                                  radius: float = 1.0, rng=None) -> tuple[np.ndarray, np.ndarray]:
+def offset_systematic_uncertainty(
+    points,
+    *,
+    scale_sd: float = 0.01,
+    misalign_sd: float = 0.005,
+    n_draws: int = 2000,
+    radius: float = 1.0,
+    rng=None,
+) -> tuple[np.ndarray, np.ndarray]:
     r"""Spread of offset-only solutions over plausible, unmodelled scale/misalignment errors.
 
     With few poses (e.g. a three-point test) the offsets absorb the scale errors: if the
@@ -477,6 +584,9 @@ def offset_systematic_uncertainty(points, *, scale_sd: float = 0.01, misalign_sd
         Their standard deviation per axis.
     """
     p = _points(points, radius, min_n=3)
+    scale_sd = _v.nonnegative(scale_sd, "scale_sd")
+    misalign_sd = _v.nonnegative(misalign_sd, "misalign_sd")
+    n_draws = _v.integer(n_draws, "n_draws", minimum=2)
     rng = np.random.default_rng(rng)
     s = rng.normal(0.0, scale_sd, (n_draws, 3))
     E = rng.normal(0.0, misalign_sd, (n_draws, 3, 3)) * (1 - np.eye(3))
@@ -488,8 +598,9 @@ def offset_systematic_uncertainty(points, *, scale_sd: float = 0.01, misalign_sd
     return o, o.std(axis=0, ddof=1)
 
 
-def orientation_count_study(means, directions, ns, *, radius: float = 1.0, max_subsets: int = 5000,
-                            rng=None) -> list[dict]:
+def orientation_count_study(
+    means, directions, ns, *, radius: float = 1.0, max_subsets: int = 5000, rng=None
+) -> list[dict]:
     r"""Residual norm error versus the number N of orientations used for the offsets (Fayat Fig. 1c).
 
     For each N, offsets are fitted (:func:`fit_offsets_batch`) on a subset of the P poses
@@ -512,12 +623,14 @@ def orientation_count_study(means, directions, ns, *, radius: float = 1.0, max_s
         One record per N: ``n``, ``residual`` (lattice subset, or orthogonal subset for
         N ≤ 3), ``residual_median`` (over subsets for N ≤ 3), ``orthogonality``.
     """
-    p = _points(means, radius, min_n=3)
+    p = _points(means, radius, name="means", min_n=3)
     d = vec3(directions, "directions", ndim=2)
     rng = np.random.default_rng(rng)
 
     def resid(o):
-        return np.mean(np.abs(np.linalg.norm(p[None] - o[:, None, :], axis=2) - radius), axis=1)
+        return np.mean(
+            np.abs(np.linalg.norm(p[None] - o[:, None, :], axis=2) - radius), axis=1
+        )
 
     out = []
     for n in ns:
@@ -528,13 +641,32 @@ def orientation_count_study(means, directions, ns, *, radius: float = 1.0, max_s
             if n == 3:
                 orth = triplet_orthogonality(d[sub])
                 k = int(np.argmax(orth))
-                out.append({"n": n, "residual": float(r[k]), "residual_median": float(np.median(r)),
-                            "orthogonality": float(orth[k])})
+                out.append(
+                    {
+                        "n": n,
+                        "residual": float(r[k]),
+                        "residual_median": float(np.median(r)),
+                        "orthogonality": float(orth[k]),
+                    }
+                )
             else:
-                out.append({"n": n, "residual": float(np.median(r)), "residual_median": float(np.median(r)),
-                            "orthogonality": float("nan")})
+                out.append(
+                    {
+                        "n": n,
+                        "residual": float(np.median(r)),
+                        "residual_median": float(np.median(r)),
+                        "orthogonality": float("nan"),
+                    }
+                )
         else:
             idx = lattice_subset(d, n)
             r = resid(fit_offsets_batch(p[idx][None], radius=radius))[0]
-            out.append({"n": n, "residual": float(r), "residual_median": float(r), "orthogonality": float("nan")})
+            out.append(
+                {
+                    "n": n,
+                    "residual": float(r),
+                    "residual_median": float(r),
+                    "orthogonality": float("nan"),
+                }
+            )
     return out

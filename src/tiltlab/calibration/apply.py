@@ -23,14 +23,22 @@ from typing import Any, NamedTuple
 import numpy as np
 import xarray as xr
 
+from .. import _validate as _v
 from .. import quaternion as _quat
 from .. import units as _units
-from ._util import CalibrationError, mat3
+from .._validate import RecordingError
+from ._util import CalibrationError, mat3, read_in, read_temp_degc
 from .accel import EllipsoidFit, OffsetFit, fit_ellipsoid, fit_offsets
 from .static import StaticStats, detect_static, gyro_offset, static_means
 from .temperature import TemperatureModel
 
-__all__ = ["Calibration", "calibrate", "applied_calibrations", "TumbleResult", "tumble_calibration"]
+__all__ = [
+    "Calibration",
+    "calibrate",
+    "applied_calibrations",
+    "TumbleResult",
+    "tumble_calibration",
+]
 
 _UNITS = {"acc": "g", "gyr": "deg/s", "mag": "uT"}
 
@@ -78,15 +86,21 @@ class Calibration:
 
     def __post_init__(self):
         for s in ("acc", "gyr", "mag"):
-            object.__setattr__(self, f"{s}_offset", _tup(getattr(self, f"{s}_offset"), (3,)))
-            object.__setattr__(self, f"{s}_matrix", _tup(getattr(self, f"{s}_matrix"), (3, 3)))
+            object.__setattr__(
+                self, f"{s}_offset", _tup(getattr(self, f"{s}_offset"), (3,))
+            )
+            object.__setattr__(
+                self, f"{s}_matrix", _tup(getattr(self, f"{s}_matrix"), (3, 3))
+            )
         for s in ("acc", "gyr"):
             tm = getattr(self, f"{s}_temp")
             if tm is not None:
                 if not isinstance(tm, TemperatureModel):
                     raise TypeError(f"{s}_temp must be a TemperatureModel")
                 if getattr(self, f"{s}_offset") is not None:
-                    raise ValueError(f"give either {s}_offset or {s}_temp (temperature-dependent offsets), not both")
+                    raise ValueError(
+                        f"give either {s}_offset or {s}_temp (temperature-dependent offsets), not both"
+                    )
                 if _units.normalise_unit(tm.units) != _UNITS[s]:
                     raise ValueError(f"{s}_temp must be in {_UNITS[s]}, got {tm.units}")
         object.__setattr__(self, "rotation", _tup(self.rotation, (3, 3)))
@@ -102,7 +116,10 @@ class Calibration:
         """The corrections this calibration applies, e.g. ``["acc_offset", "acc_matrix"]``."""
         out = []
         for s in ("acc", "gyr", "mag"):
-            if getattr(self, f"{s}_offset") is not None or getattr(self, f"{s}_temp", None) is not None:
+            if (
+                getattr(self, f"{s}_offset") is not None
+                or getattr(self, f"{s}_temp", None) is not None
+            ):
                 out.append(f"{s}_offset")
             if getattr(self, f"{s}_matrix") is not None:
                 out.append(f"{s}_matrix")
@@ -155,13 +172,15 @@ def applied_calibrations(rec: xr.Dataset) -> list[dict]:
 
 def _temp_celsius(rec):
     if "temp" not in rec:
-        raise CalibrationError("this calibration has temperature-dependent offsets but the Recording has no 'temp'")
-    t = rec["temp"].values.astype(float)
-    u = _units.normalise_unit(rec["temp"].attrs.get("units", "degC"))
-    return t - 273.15 if u == "K" else t
+        raise CalibrationError(
+            "this calibration has temperature-dependent offsets but the Recording has no 'temp'"
+        )
+    return read_temp_degc(rec["temp"])
 
 
-def calibrate(rec: xr.Dataset, calibration: Calibration, *, allow_stacking: bool = False) -> xr.Dataset:
+def calibrate(
+    rec: xr.Dataset, calibration: Calibration, *, allow_stacking: bool = False
+) -> xr.Dataset:
     """Apply a :class:`Calibration` to a Recording; returns a new Recording.
 
     Parameters
@@ -186,13 +205,19 @@ def calibrate(rec: xr.Dataset, calibration: Calibration, *, allow_stacking: bool
     history = applied_calibrations(rec)
     fp = calibration.fingerprint()
     if any(h.get("fingerprint") == fp for h in history):
-        raise CalibrationError(f"calibration {calibration.name!r} (fingerprint {fp}) was already applied to this Recording")
+        raise CalibrationError(
+            f"calibration {calibration.name!r} (fingerprint {fp}) was already applied to this Recording"
+        )
     done = {c for h in history for c in h.get("applied", [])}
-    todo = [c for c in calibration.corrects() if c.split("_")[0] in rec or c == "rotation"]
+    todo = [
+        c for c in calibration.corrects() if c.split("_")[0] in rec or c == "rotation"
+    ]
     twice = sorted(done.intersection(todo))
     if twice and not allow_stacking:
-        raise CalibrationError(f"{', '.join(twice)} already corrected by an earlier calibration "
-                               "(pass allow_stacking=True to stack a residual correction)")
+        raise CalibrationError(
+            f"{', '.join(twice)} already corrected by an earlier calibration "
+            "(pass allow_stacking=True to stack a residual correction)"
+        )
     out = rec.copy(deep=True)
     R = None if calibration.rotation is None else np.asarray(calibration.rotation)
     applied = []
@@ -200,8 +225,15 @@ def calibrate(rec: xr.Dataset, calibration: Calibration, *, allow_stacking: bool
         if s not in rec:
             continue
         x = rec[s].values.astype(float)
-        units = rec[s].attrs.get("units", _UNITS[s])
-        f = _units.conversion_factor(_UNITS[s], units)  # calibration units -> data units
+        if "units" not in rec[s].attrs:
+            raise RecordingError(
+                f"Recording variable {s!r} has no 'units' attribute: the calibration "
+                f"(in {_UNITS[s]}) cannot be converted to it"
+            )
+        units = rec[s].attrs["units"]
+        f = _units.conversion_factor(
+            _UNITS[s], units
+        )  # calibration units -> data units
         tm = getattr(calibration, f"{s}_temp", None)
         o = getattr(calibration, f"{s}_offset")
         C = getattr(calibration, f"{s}_matrix")
@@ -224,8 +256,17 @@ def calibrate(rec: xr.Dataset, calibration: Calibration, *, allow_stacking: bool
             qR = _quat.from_matrix(R)
             out["q_ref"].values[...] = _quat.mul(rec["q_ref"].values, _quat.conj(qR))
     if not applied:
-        raise CalibrationError("the calibration corrects nothing present in this Recording")
-    history.append({"name": calibration.name, "fingerprint": fp, "applied": applied, "calibration": calibration.to_dict()})
+        raise CalibrationError(
+            "the calibration corrects nothing present in this Recording"
+        )
+    history.append(
+        {
+            "name": calibration.name,
+            "fingerprint": fp,
+            "applied": applied,
+            "calibration": calibration.to_dict(),
+        }
+    )
     out.attrs["calibration"] = json.dumps(history)
     return out
 
@@ -242,33 +283,90 @@ class TumbleResult(NamedTuple):
     gyr_stderr: np.ndarray
 
 
-def tumble_calibration(rec: xr.Dataset, *, model: str = "offsets", intervals=None, trigger=None,
-                       threshold: float = 3.0, min_duration_s: float = 0.4, full_scale: float | None = None,
-                       name: str = "tumble test") -> TumbleResult:
+def tumble_calibration(
+    rec: xr.Dataset,
+    *,
+    model: str = "offsets",
+    intervals=None,
+    trigger=None,
+    threshold_deg_s: float = 3.0,
+    min_duration_s: float = 0.4,
+    full_scale_g: float | None = None,
+    name: str = "tumble test",
+) -> TumbleResult:
     """Offsets (and optionally scale/misalignment) from a tumble-test Recording.
 
     Detects still periods (:func:`detect_static`, or ``intervals``/``trigger``), averages
     the accelerometer in each, fits ``model`` = ``"offsets"`` (:func:`fit_offsets`) or
     ``"ellipsoid"`` (:func:`fit_ellipsoid`, needs ≥ 9 well-spread poses), and takes
     gyroscope offsets as medians during stillness.
+
+    Parameters
+    ----------
+    rec : xarray.Dataset
+        Tumble-test Recording (``acc``, ``gyr`` with units; ``fs``).
+    model : {"offsets", "ellipsoid"}
+    intervals : array_like (P, 2), optional
+        Still periods; default detected.
+    trigger : DataArray or array_like (N,), optional
+        Trigger channel for :func:`detect_static` (e.g. ``rec["trigger"]``).
+    threshold_deg_s, min_duration_s : float
+        Still-period detection settings (°/s, s), see :func:`detect_static`.
+    full_scale_g : float, optional
+        Accelerometer full scale (g): periods with saturated samples are refused.
+    name : str
+        Name of the resulting :class:`Calibration`.
     """
     if model not in ("offsets", "ellipsoid"):
-        raise ValueError("model must be 'offsets' or 'ellipsoid'")
-    fs = float(rec.attrs["fs"])
-    acc = rec["acc"].values * _units.conversion_factor(rec["acc"].attrs.get("units", "g"), "g")
-    gyr = rec["gyr"].values * _units.conversion_factor(rec["gyr"].attrs.get("units", "deg/s"), "deg/s")
+        raise ValueError(f"model must be 'offsets' or 'ellipsoid', got {model!r}")
+    if not isinstance(rec, xr.Dataset):
+        raise TypeError(
+            f"rec must be a Recording (xarray.Dataset), got {type(rec).__name__}"
+        )
+    acc = read_in(rec, "acc", "g", need_fs=False)[0].values
+    gyr = read_in(rec, "gyr", "deg/s")[0].values
+    if full_scale_g is not None:
+        full_scale_g = _v.positive(full_scale_g, "full_scale_g")
     if intervals is None:
-        intervals = detect_static(gyr, fs, trigger=trigger, threshold=threshold, min_duration_s=min_duration_s)
-    stats = static_means(acc, intervals, full_scale=full_scale, min_periods=3 if model == "offsets" else 9)
+        intervals = detect_static(
+            rec,
+            trigger=trigger,
+            threshold_deg_s=threshold_deg_s,
+            min_duration_s=min_duration_s,
+        )
+    stats = static_means(
+        acc,
+        intervals,
+        full_scale=full_scale_g,
+        min_periods=3 if model == "offsets" else 9,
+    )
     go, gse = gyro_offset(gyr, intervals)
     if model == "offsets":
         fit = fit_offsets(stats.mean, sem=stats.sem)
-        cal = Calibration(name=name, acc_offset=fit.offset, gyr_offset=go,
-                          info={"acc_offset_stderr": fit.stderr.tolist(), "gyr_offset_stderr": gse.tolist(),
-                                "n_poses": int(fit.n), "model": model})
+        cal = Calibration(
+            name=name,
+            acc_offset=fit.offset,
+            gyr_offset=go,
+            info={
+                "acc_offset_stderr": fit.stderr.tolist(),
+                "gyr_offset_stderr": gse.tolist(),
+                "n_poses": int(fit.n),
+                "model": model,
+            },
+        )
     else:
         fit = fit_ellipsoid(stats.mean, sem=stats.sem)
-        cal = Calibration(name=name, acc_offset=fit.offset, acc_matrix=fit.matrix, gyr_offset=go,
-                          info={"acc_offset_stderr": fit.offset_stderr.tolist(), "gyr_offset_stderr": gse.tolist(),
-                                "acc_matrix_stderr": fit.matrix_stderr.tolist(), "n_poses": int(fit.n), "model": model})
+        cal = Calibration(
+            name=name,
+            acc_offset=fit.offset,
+            acc_matrix=fit.matrix,
+            gyr_offset=go,
+            info={
+                "acc_offset_stderr": fit.offset_stderr.tolist(),
+                "gyr_offset_stderr": gse.tolist(),
+                "acc_matrix_stderr": fit.matrix_stderr.tolist(),
+                "n_poses": int(fit.n),
+                "model": model,
+            },
+        )
     return TumbleResult(cal, np.asarray(intervals), stats, fit, gse)

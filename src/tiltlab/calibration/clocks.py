@@ -25,7 +25,8 @@ from scipy.interpolate import CubicSpline
 from scipy.optimize import minimize_scalar
 from scipy.signal import correlate, correlation_lags
 
-from ._util import CalibrationError, check_fs
+from .. import _validate as _v
+from ._util import CalibrationError
 
 __all__ = ["LagEstimate", "estimate_lag", "SlipRepair", "repair_ttl_slips"]
 
@@ -39,49 +40,77 @@ class LagEstimate(NamedTuple):
     correlation: float
 
 
-def _prep(z):
-    z = np.asarray(z, dtype=float)
+def _centre(z: np.ndarray) -> np.ndarray:
     if z.ndim == 1:
         z = z[:, None]
-    if z.ndim != 2 or not np.all(np.isfinite(z)):
-        raise ValueError("signals must be finite arrays of shape (N,) or (N, k)")
     return z - z.mean(axis=0)
 
 
-def estimate_lag(x, y, fs: float, *, fs_y: float | None = None, max_lag_s: float | None = None) -> LagEstimate:
+def _channels(data, name: str, var: str, fs, need_fs: bool) -> _v.Signal:
+    s = _v.signal(data, name, var=var, fs=fs, width=None, ndim=None, need_fs=need_fs)
+    if s.values.ndim not in (1, 2):
+        raise ValueError(f"{name} must have shape (N,) or (N, k), got {s.values.shape}")
+    return s
+
+
+def estimate_lag(
+    x,
+    y,
+    fs: float | None = None,
+    *,
+    fs_y: float | None = None,
+    max_lag_s: float | None = None,
+    var: str = "acc",
+) -> LagEstimate:
     """Constant lag between two recordings of the same motion.
 
     Parameters
     ----------
-    x, y : array_like (N,) or (N, k)
-        The two signals (same channels; e.g. acceleration norms or axes). Channel
-        correlations are summed.
-    fs : float
-        Sampling rate of ``x`` (Hz).
+    x, y : Recording, DataArray or array_like (N,) or (N, k)
+        The two signals (same channels; e.g. acceleration norms or axes; for a
+        Recording, its variable ``var``). Channel correlations are summed.
+    fs : float, optional
+        Sampling rate of ``x`` (Hz); read from the attrs of labelled ``x``, mandatory
+        for a plain array.
     fs_y : float, optional
-        Sampling rate of ``y`` if different; ``y`` is then interpolated (cubic spline)
-        onto the time grid of ``x`` first.
+        Sampling rate of ``y`` (Hz); read from the attrs of labelled ``y``; default
+        ``fs``. If different, ``y`` is interpolated (cubic spline) onto the time grid
+        of ``x`` first.
     max_lag_s : float, optional
         Search range (s); default a quarter of the shorter record.
+    var : str
+        Variable read from a Recording.
 
     Returns
     -------
     LagEstimate
     """
-    fs = check_fs(fs)
-    a, b = _prep(x), _prep(y)
+    sx = _channels(x, "x", var, fs, True)
+    sy = _channels(y, "y", var, fs_y, False)
+    fs = sx.fs
+    fy = fs if sy.fs is None else sy.fs
+    a, b = _centre(sx.values), _centre(sy.values)
     if a.shape[1] != b.shape[1]:
-        raise ValueError("x and y must have the same number of channels")
-    if fs_y is not None and float(fs_y) != fs:
-        fy = check_fs(fs_y)
+        raise ValueError(
+            f"x and y must have the same number of channels, got {a.shape[1]} and "
+            f"{b.shape[1]}"
+        )
+    if max_lag_s is not None:
+        max_lag_s = _v.nonnegative(max_lag_s, "max_lag_s")
+    if fy != fs:
         ty = np.arange(b.shape[0]) / fy
         tx = np.arange(int(np.floor(ty[-1] * fs)) + 1) / fs
-        b = _prep(CubicSpline(ty, b, axis=0)(tx))
+        b = _centre(CubicSpline(ty, b, axis=0)(tx))
     n = min(a.shape[0], b.shape[0])
     if n < 8:
-        raise CalibrationError("signals too short to estimate a lag")
+        raise CalibrationError(
+            f"signals too short to estimate a lag ({n} common samples, needs 8)"
+        )
     max_lag = int(round((max_lag_s if max_lag_s is not None else n / fs / 4) * fs))
-    cc = sum(correlate(b[:, j], a[:, j], mode="full", method="fft") for j in range(a.shape[1]))
+    cc = sum(
+        correlate(b[:, j], a[:, j], mode="full", method="fft")
+        for j in range(a.shape[1])
+    )
     lags = correlation_lags(b.shape[0], a.shape[0], mode="full")
     sel = np.abs(lags) <= max_lag
     k0 = int(lags[sel][np.argmax(cc[sel])])
@@ -99,7 +128,9 @@ def estimate_lag(x, y, fs: float, *, fs_y: float | None = None, max_lag_s: float
         den = np.sqrt(np.sum(xa * xa) * np.sum(yb * yb))
         return -float(np.sum(xa * yb) / den) if den > 0 else 0.0
 
-    res = minimize_scalar(neg_corr, bounds=(k0 - 1.0, k0 + 1.0), method="bounded", options={"xatol": 1e-4})
+    res = minimize_scalar(
+        neg_corr, bounds=(k0 - 1.0, k0 + 1.0), method="bounded", options={"xatol": 1e-4}
+    )
     d = float(res.x)
     return LagEstimate(d / fs, d, -float(res.fun))
 
@@ -116,7 +147,9 @@ class SlipRepair(NamedTuple):
     cycle_lengths: np.ndarray
 
 
-def repair_ttl_slips(mocap, ttl_imu_index, *, cycle: int = 6, first_frame: int = 0, max_slip: int = 1) -> SlipRepair:
+def repair_ttl_slips(
+    mocap, ttl_imu_index, *, cycle: int = 6, first_frame: int = 0, max_slip: int = 1
+) -> SlipRepair:
     """Align motion-capture frames with IMU samples using TTL timestamps (Fayat App. A.2).
 
     Parameters
@@ -143,19 +176,24 @@ def repair_ttl_slips(mocap, ttl_imu_index, *, cycle: int = 6, first_frame: int =
     idx = np.asarray(ttl_imu_index, dtype=np.int64)
     if idx.ndim != 1 or idx.size < 2:
         raise CalibrationError("need at least two TTL timestamps")
-    if cycle < 1:
-        raise ValueError("cycle must be >= 1")
+    cycle = _v.integer(cycle, "cycle", minimum=1)
+    first_frame = _v.integer(first_frame, "first_frame", minimum=0)
+    max_slip = _v.integer(max_slip, "max_slip", minimum=0)
     L = np.diff(idx)
     if np.any(L <= 0):
         raise CalibrationError("TTL timestamps must be strictly increasing IMU indices")
     bad = np.abs(L - cycle) > max_slip
     if np.any(bad):
         k = int(np.flatnonzero(bad)[0])
-        raise CalibrationError(f"cycle {k} spans {L[k]} IMU samples for {cycle} mocap frames (slip > {max_slip}): "
-                               "a TTL pulse is missing or the cycle length is wrong")
+        raise CalibrationError(
+            f"cycle {k} spans {L[k]} IMU samples for {cycle} mocap frames (slip > {max_slip}): "
+            "a TTL pulse is missing or the cycle length is wrong"
+        )
     need = first_frame + cycle * (idx.size - 1)
     if m.shape[0] < need:
-        raise CalibrationError(f"mocap has {m.shape[0]} frames, the timestamps need {need}")
+        raise CalibrationError(
+            f"mocap has {m.shape[0]} frames, the timestamps need {need}"
+        )
     pieces = []
     for k, n_imu in enumerate(L):
         f0 = first_frame + k * cycle
@@ -166,5 +204,10 @@ def repair_ttl_slips(mocap, ttl_imu_index, *, cycle: int = 6, first_frame: int =
             frames = frames[:n_imu]
         pieces.append(frames)
     sel = np.concatenate(pieces)
-    return SlipRepair(m[sel], np.arange(idx[0], idx[-1]), int(np.sum(np.maximum(L - cycle, 0))),
-                      int(np.sum(np.maximum(cycle - L, 0))), L)
+    return SlipRepair(
+        m[sel],
+        np.arange(idx[0], idx[-1]),
+        int(np.sum(np.maximum(L - cycle, 0))),
+        int(np.sum(np.maximum(cycle - L, 0))),
+        L,
+    )

@@ -30,11 +30,14 @@ References
 
 from __future__ import annotations
 
+import dataclasses
 from typing import NamedTuple
 
 import numpy as np
+import xarray as xr
 
-from ._util import CalibrationError, check_fs, vec3
+from .. import _validate as _v
+from ._util import CalibrationError, read_in, vec3
 
 __all__ = [
     "deg_per_hour",
@@ -47,86 +50,175 @@ __all__ = [
     "allan_noise_parameters",
 ]
 
+_METHODS = ("first_window", "linear_fit", "prior", "none")
+
 
 def deg_per_hour(rate_deg_s) -> np.ndarray:
     """Angle accumulated in one hour (°) by a constant rate error (°/s): ``3600 × rate``."""
     return np.asarray(rate_deg_s, dtype=float) * 3600.0
 
 
-def integrate_rate(gyr, fs: float) -> np.ndarray:
-    r"""Per-axis integrated angle (°) of a rate (°/s), :math:`\theta_k = \sum_{j<k}\omega_j/f_s`, θ₀ = 0.
-
-    This is LaCanna's per-axis rectangular integration (Appendix A); it is an angle only
-    for small rotations about fixed axes (static drift tests).
-    """
-    fs = check_fs(fs)
-    g = vec3(gyr, "gyr", ndim=2)
+def _integrate(g: np.ndarray, fs: float) -> np.ndarray:
     out = np.zeros_like(g)
     np.cumsum(g[:-1] / fs, axis=0, out=out[1:])
     return out
 
 
-def drift_slope(angle, fs: float, *, start_s: float = 0.0, stop_s: float | None = None) -> np.ndarray:
-    """Least-squares slope (°/s) of an integrated angle over ``[start_s, stop_s)``, per axis."""
-    fs = check_fs(fs)
-    th = vec3(angle, "angle", ndim=2)
+def integrate_rate(gyr, fs: float | None = None, *, units: str | None = None):
+    r"""Per-axis integrated angle (°) of a rate, :math:`\theta_k = \sum_{j<k}\omega_j/f_s`,
+    θ₀ = 0.
+
+    This is LaCanna's per-axis rectangular integration (Appendix A); it is an angle only
+    for small rotations about fixed axes (static drift tests).
+
+    Parameters
+    ----------
+    gyr : Recording, DataArray or array_like (N, 3)
+        Angular velocity (a Recording's ``gyr``); labelled input carries its units, a
+        plain array is in ``units`` (default °/s).
+    fs : float, optional
+        Sampling rate (Hz); read from the attrs of labelled input, mandatory for a
+        plain array.
+    units : str, optional
+        Units of a plain-array ``gyr`` (``"deg/s"`` if not given).
+
+    Returns
+    -------
+    ndarray or DataArray (N, 3)
+        Angle in degrees (a DataArray with ``units="deg"`` for labelled input).
+    """
+    s, _ = read_in(gyr, "gyr", "deg/s", fs=fs, units=units)
+    return _v.labelled(_integrate(s.values, s.fs), s, "angle", units="deg")
+
+
+def _read_angle(angle, fs):
+    # an integrated angle carries units "deg" (not a Recording unit): read fs and values
+    if isinstance(angle, xr.DataArray) and "units" in angle.attrs:
+        units = angle.attrs["units"]
+        angle = angle.copy(deep=False)
+        angle.attrs = {k: v for k, v in angle.attrs.items() if k != "units"}
+        s = _v.signal(angle, "angle", fs=fs)
+        return dataclasses.replace(s, attrs={**s.attrs, "units": units})
+    return _v.signal(angle, "angle", fs=fs)
+
+
+def _slope(
+    th: np.ndarray, fs: float, start_s: float, stop_s: float | None
+) -> np.ndarray:
     a = int(round(start_s * fs))
     b = th.shape[0] if stop_s is None else int(round(stop_s * fs))
     if b - a < 2:
-        raise CalibrationError("fewer than two samples in the slope window")
+        raise CalibrationError(
+            f"fewer than two samples in the slope window [start_s = {start_s:g} s, "
+            f"stop_s = {stop_s!r} s) at fs = {fs:g} Hz"
+        )
     t = np.arange(a, b) / fs
     tc = t - t.mean()
     seg = th[a:b]
     return tc @ (seg - seg.mean(axis=0)) / (tc @ tc)
 
 
+def drift_slope(
+    angle, fs: float | None = None, *, start_s: float = 0.0, stop_s: float | None = None
+) -> np.ndarray:
+    """Least-squares slope of an integrated angle over ``[start_s, stop_s)``, per axis.
+
+    Parameters
+    ----------
+    angle : DataArray or array_like (N, 3)
+        Integrated angle (e.g. :func:`integrate_rate`, in °).
+    fs : float, optional
+        Sampling rate (Hz); read from the attrs of labelled input, mandatory for a
+        plain array.
+    start_s, stop_s : float
+        Window (s from the first sample); ``stop_s=None``: to the end.
+
+    Returns
+    -------
+    ndarray (3,)
+        Slope in the angle's unit per second (°/s for an angle in °).
+    """
+    s = _read_angle(angle, fs)
+    start_s = _v.nonnegative(start_s, "start_s")
+    if stop_s is not None:
+        stop_s = _v.positive(stop_s, "stop_s")
+    return _slope(s.values, s.fs, start_s, stop_s)
+
+
 class DriftCorrection(NamedTuple):
-    """``angle`` (N, 3) corrected integrated angle (°), ``slope`` (3,) removed rate (°/s),
-    ``method``."""
+    """``angle`` (N, 3) corrected integrated angle (°; a DataArray for labelled input),
+    ``slope`` (3,) removed rate (°/s), ``method``."""
 
     angle: np.ndarray
     slope: np.ndarray
     method: str
 
 
-def correct_drift(gyr, fs: float, method: str = "first_window", *, window_s: float = 30.0, prior=None) -> DriftCorrection:
+def correct_drift(
+    gyr,
+    fs: float | None = None,
+    *,
+    method: str = "first_window",
+    window_s: float = 30.0,
+    prior_deg_s=None,
+    units: str | None = None,
+) -> DriftCorrection:
     """Integrate a gyroscope and remove a linear drift by one of LaCanna's three methods.
 
     Parameters
     ----------
-    gyr : array_like (N, 3)
-        Angular velocity (°/s).
-    fs : float
-        Sampling rate (Hz).
+    gyr : Recording, DataArray or array_like (N, 3)
+        Angular velocity (a Recording's ``gyr``); labelled input carries its units, a
+        plain array is in ``units`` (default °/s).
+    fs : float, optional
+        Sampling rate (Hz); read from the attrs of labelled input, mandatory for a
+        plain array.
     method : {"first_window", "linear_fit", "prior", "none"}
         See the module docstring.
     window_s : float
         Length of the initial still window for ``"first_window"`` (s).
-    prior : array_like (3,)
+    prior_deg_s : array_like (3,)
         Drift rate (°/s) from an earlier calibration, for ``"prior"``.
+    units : str, optional
+        Units of a plain-array ``gyr`` (``"deg/s"`` if not given).
     """
-    fs = check_fs(fs)
-    g = vec3(gyr, "gyr", ndim=2)
-    th = integrate_rate(g, fs)
+    s, _ = read_in(gyr, "gyr", "deg/s", fs=fs, units=units)
+    g, fs = s.values, s.fs
+    if method not in _METHODS:
+        raise ValueError(f"method must be one of {', '.join(_METHODS)}; got {method!r}")
+    window_s = _v.positive(window_s, "window_s")
+    th = _integrate(g, fs)
     if method == "none":
         slope = np.zeros(3)
     elif method == "first_window":
         if window_s * fs > g.shape[0]:
-            raise CalibrationError(f"record ({g.shape[0] / fs:.1f} s) shorter than the {window_s} s drift window")
-        slope = drift_slope(th, fs, stop_s=window_s)
+            raise CalibrationError(
+                f"the record ({g.shape[0] / fs:.1f} s) is shorter than the drift window "
+                f"window_s = {window_s:g} s"
+            )
+        slope = _slope(th, fs, 0.0, window_s)
     elif method == "linear_fit":
-        slope = drift_slope(th, fs)
-    elif method == "prior":
-        if prior is None:
-            raise ValueError("method 'prior' needs the prior drift rate (°/s)")
-        slope = vec3(prior, "prior", ndim=1)
-    else:
-        raise ValueError(f"unknown method {method!r}")
+        slope = _slope(th, fs, 0.0, None)
+    else:  # "prior"
+        if prior_deg_s is None:
+            raise ValueError(
+                "method 'prior' needs prior_deg_s, the drift rate (°/s) from an earlier "
+                "calibration"
+            )
+        slope = vec3(prior_deg_s, "prior_deg_s", ndim=1)
     t = np.arange(g.shape[0])[:, None] / fs
-    return DriftCorrection(th - t * slope, np.asarray(slope, float), method)
+    angle = _v.labelled(th - t * slope, s, "angle", units="deg")
+    return DriftCorrection(angle, np.asarray(slope, float), method)
 
 
-def allan_deviation(rate, fs: float, taus=None, *, n_taus: int = 40) -> tuple[np.ndarray, np.ndarray]:
+def allan_deviation(
+    rate,
+    fs: float | None = None,
+    *,
+    taus_s=None,
+    n_taus: int = 40,
+    var: str = "gyr",
+) -> tuple[np.ndarray, np.ndarray]:
     r"""Overlapping Allan deviation of a rate signal.
 
     .. math:: \sigma^2(\tau) = \frac{1}{2\tau^2 (N - 2m)} \sum_{k=0}^{N-2m-1}
@@ -136,34 +228,50 @@ def allan_deviation(rate, fs: float, taus=None, *, n_taus: int = 40) -> tuple[np
 
     Parameters
     ----------
-    rate : array_like (N,) or (N, 3)
-    fs : float
-    taus : array_like, optional
+    rate : Recording, DataArray or array_like (N,) or (N, 3)
+        The rate (for a Recording, its variable ``var``).
+    fs : float, optional
+        Sampling rate (Hz); read from the attrs of labelled input, mandatory for a
+        plain array.
+    taus_s : array_like, optional
         Averaging times (s); default ``n_taus`` log-spaced values from 1/fs to N/(10 fs).
+    n_taus : int
+        Number of default averaging times.
+    var : str
+        Variable read from a Recording.
 
     Returns
     -------
     taus : ndarray (K,)
-        Averaging times actually used (rounded to whole samples, unique).
+        Averaging times actually used (s; rounded to whole samples, unique).
     adev : ndarray (K,) or (K, 3)
         Allan deviation in the units of ``rate``.
     """
-    fs = check_fs(fs)
-    x = np.asarray(rate, dtype=float)
+    s = _v.signal(rate, "rate", var=var, fs=fs, width=None, ndim=None)
+    fs, x = s.fs, s.values
+    if x.ndim not in (1, 2):
+        raise ValueError(f"rate must have shape (N,) or (N, k), got {x.shape}")
+    n_taus = _v.integer(n_taus, "n_taus", minimum=1)
     one = x.ndim == 1
     x = x.reshape(x.shape[0], -1)
     n = x.shape[0]
     if n < 20:
-        raise CalibrationError("record too short for an Allan deviation")
-    if taus is None:
-        m = np.unique(np.round(np.logspace(0, np.log10(max(n // 10, 2)), n_taus)).astype(np.int64))
+        raise CalibrationError(
+            f"the record ({n} samples) is too short for an Allan deviation (needs 20)"
+        )
+    if taus_s is None:
+        m = np.logspace(0, np.log10(max(n // 10, 2)), n_taus)
+        m = np.unique(np.round(m).astype(np.int64))
     else:
-        m = np.unique(np.round(np.asarray(taus, float) * fs).astype(np.int64))
+        t = _v.vectors(taus_s, "taus_s", width=None, ndim=None).ravel()
+        if np.any(t <= 0):
+            raise ValueError(f"taus_s must be positive durations (s), got {t[t <= 0]}")
+        m = np.unique(np.round(t * fs).astype(np.int64))
         m = m[(m >= 1) & (m <= (n - 1) // 2)]
     theta = np.vstack([np.zeros((1, x.shape[1])), np.cumsum(x, axis=0) / fs])
     out = np.empty((m.size, x.shape[1]))
     for i, mi in enumerate(m):
-        d = theta[2 * mi:] - 2 * theta[mi:-mi] + theta[: -2 * mi]
+        d = theta[2 * mi :] - 2 * theta[mi:-mi] + theta[: -2 * mi]
         tau = mi / fs
         out[i] = np.sqrt(np.mean(d * d, axis=0) / (2 * tau * tau))
     return m / fs, out[:, 0] if one else out
@@ -180,15 +288,24 @@ class AllanNoise(NamedTuple):
     rrw: np.ndarray
 
 
-def allan_noise_parameters(taus, adev) -> AllanNoise:
+def allan_noise_parameters(taus_s, adev) -> AllanNoise:
     """Read the IEEE-952 noise terms off an Allan deviation curve.
+
+    ``taus_s`` (K,) averaging times (s) and ``adev`` (K,) or (K, k) Allan deviations, as
+    returned by :func:`allan_deviation`.
 
     ARW: median of σ(τ)√τ over the points where the local log-log slope is within
     ±0.15 of −1/2; bias instability: min σ / 0.664; RRW: median of σ(τ)√(3/τ) where the
     slope is within ±0.15 of +1/2.
     """
-    t = np.asarray(taus, float)
-    a = np.asarray(adev, float)
+    t = _v.vectors(taus_s, "taus_s", width=None, ndim=1)
+    if np.any(t <= 0):
+        raise ValueError("taus_s must be positive durations (s)")
+    a = _v.vectors(adev, "adev", width=None, ndim=None)
+    if a.shape[0] != t.size:
+        raise ValueError(
+            f"adev must have one row per tau ({t.size}), got shape {a.shape}"
+        )
     one = a.ndim == 1
     a = a.reshape(t.size, -1)
     lt, la = np.log(t), np.log(a)
@@ -201,6 +318,8 @@ def allan_noise_parameters(taus, adev) -> AllanNoise:
         bi.append(a[k, j] / np.sqrt(2 * np.log(2) / np.pi))
         tmin.append(t[k])
         sel = np.abs(slope[:, j] - 0.5) < 0.15
-        rrw.append(np.median(a[sel, j] * np.sqrt(3.0 / t[sel])) if sel.any() else np.nan)
+        rrw.append(
+            np.median(a[sel, j] * np.sqrt(3.0 / t[sel])) if sel.any() else np.nan
+        )
     f = (lambda v: float(v[0])) if one else np.array
     return AllanNoise(f(arw), f(bi), f(tmin), f(rrw))

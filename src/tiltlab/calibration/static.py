@@ -10,6 +10,13 @@ no still sample at all. :func:`robust_gyro_offset` therefore estimates a first-p
 offset from the quietest windows (lowest variance — independent of the offset
 itself) before thresholding.
 
+The thresholding is tiltlab's one still-period detector, :func:`tiltlab.dsp.still_mask`
+(smooth → threshold → merge gaps → trim edges → drop short periods); its thresholds are
+in °/s, and gyroscopes in rad/s are converted first.
+
+Inputs are Recordings (their ``gyr``), labelled DataArrays (``fs`` and ``units`` from the
+attrs) or plain arrays in °/s with an explicit ``fs``.
+
 Intervals are integer arrays of shape (P, 2) holding ``[start, stop)`` sample indices.
 
 References
@@ -24,10 +31,12 @@ from __future__ import annotations
 from typing import NamedTuple
 
 import numpy as np
-from scipy.ndimage import uniform_filter1d
+import xarray as xr
 
+from .. import _validate as _v
+from ..dsp import still_mask
 from ..intervals import intervals_to_mask, mask_to_intervals
-from ._util import CalibrationError, check_fs, vec3
+from ._util import CalibrationError, read_in, vec3
 
 __all__ = [
     "mask_to_intervals",
@@ -48,8 +57,14 @@ def _check_intervals(intervals, n: int) -> np.ndarray:
     return iv
 
 
-def static_intervals_from_trigger(trigger, fs: float, *, window_s: float = 0.4, gap_s: float = 0.0,
-                                  level: float = 0.5) -> np.ndarray:
+def static_intervals_from_trigger(
+    trigger,
+    fs: float | None = None,
+    *,
+    window_s: float = 0.4,
+    gap_s: float = 0.0,
+    level: float = 0.5,
+) -> np.ndarray:
     """Still periods defined by a digital trigger: the ``window_s`` preceding each rising edge.
 
     Fayat et al. [1]_ (§2.5) used the 400 ms of immobility preceding each trigger, which
@@ -57,10 +72,12 @@ def static_intervals_from_trigger(trigger, fs: float, *, window_s: float = 0.4, 
 
     Parameters
     ----------
-    trigger : array_like (N,)
-        Trigger channel; a rising edge is a crossing of ``level`` from below.
-    fs : float
-        Sampling rate (Hz).
+    trigger : Recording, DataArray or array_like (N,)
+        Trigger channel (a Recording's ``trigger`` variable); a rising edge is a
+        crossing of ``level`` from below.
+    fs : float, optional
+        Sampling rate (Hz); read from the attrs of labelled input, mandatory for a
+        plain array.
     window_s : float
         Duration of each still period (s).
     gap_s : float
@@ -73,22 +90,27 @@ def static_intervals_from_trigger(trigger, fs: float, *, window_s: float = 0.4, 
     ndarray (P, 2)
         ``[start, stop)`` sample indices; edges too early for a full window are skipped.
     """
-    fs = check_fs(fs)
-    t = np.asarray(trigger, dtype=float)
-    if t.ndim != 1:
-        raise ValueError("trigger must be 1-D")
-    hi = t > level
+    s = _v.signal(trigger, "trigger", fs=fs, width=None, ndim=1)
+    fs = s.fs
+    window_s = _v.positive(window_s, "window_s")
+    gap_s = _v.nonnegative(gap_s, "gap_s")
+    level = _v.finite(level, "level")
+    hi = s.values > level
     edges = np.flatnonzero(hi[1:] & ~hi[:-1]) + 1
     w, g = int(round(window_s * fs)), int(round(gap_s * fs))
     if w < 1:
-        raise ValueError("window_s is shorter than one sample")
+        raise ValueError(
+            f"window_s = {window_s!r} s is shorter than one sample at fs = {fs:g} Hz"
+        )
     stops = edges - g
     starts = stops - w
     ok = starts >= 0
     return np.column_stack([starts[ok], stops[ok]]).astype(np.int64).reshape(-1, 2)
 
 
-def robust_gyro_offset(gyr, fs: float, *, window_s: float = 0.5, quantile: float = 0.2) -> np.ndarray:
+def robust_gyro_offset(
+    gyr, fs: float | None = None, *, window_s: float = 0.5, quantile: float = 0.2
+) -> np.ndarray:
     """First-pass gyroscope offset from the quietest windows of a recording.
 
     The record is cut into non-overlapping windows of ``window_s``; the windows whose
@@ -96,83 +118,144 @@ def robust_gyro_offset(gyr, fs: float, *, window_s: float = 0.5, quantile: float
     the per-axis median of their samples is returned. Variance does not depend on the
     offset, so this works for offsets of tens of °/s, and it needs only ``quantile`` of
     the record to be still.
+
+    Parameters
+    ----------
+    gyr : Recording, DataArray or array_like (N, 3)
+        Angular velocity (a Recording's ``gyr``).
+    fs : float, optional
+        Sampling rate (Hz); read from the attrs of labelled input, mandatory for a
+        plain array.
+    window_s : float
+        Window length (s).
+    quantile : float
+        Fraction of the windows (the quietest) taken as still, in (0, 1].
+
+    Returns
+    -------
+    ndarray (3,)
+        The offset, in the units of ``gyr``.
     """
-    fs = check_fs(fs)
-    g = vec3(gyr, "gyr", ndim=2)
-    w = max(int(round(window_s * fs)), 2)
+    s = _v.signal(gyr, "gyr", fs=fs)
+    window_s = _v.positive(window_s, "window_s")
+    quantile = _v.fraction(quantile, "quantile", open_low=True)
+    g = s.values
+    w = max(int(round(window_s * s.fs)), 2)
     nw = g.shape[0] // w
     if nw < 1:
-        raise CalibrationError("recording shorter than one window: cannot estimate a gyro offset")
+        raise CalibrationError(
+            f"the recording ({g.shape[0]} samples) is shorter than one window of "
+            f"window_s = {window_s:g} s: cannot estimate a gyro offset"
+        )
     blocks = g[: nw * w].reshape(nw, w, 3)
     var = blocks.var(axis=1).sum(axis=1)
     quiet = var <= np.quantile(var, quantile)
     return np.median(blocks[quiet].reshape(-1, 3), axis=0)
 
 
-def detect_static(gyr, fs: float, *, acc=None, trigger=None, threshold: float = 3.0, smooth_s: float = 0.1,
-                  min_duration_s: float = 0.4, merge_gap_s: float = 0.0, trim_s: float | None = None,
-                  acc_std_threshold: float | None = None, offset=None, trigger_window_s: float = 0.4) -> np.ndarray:
+def detect_static(
+    gyr,
+    fs: float | None = None,
+    *,
+    units: str | None = None,
+    acc=None,
+    trigger=None,
+    threshold_deg_s: float = 3.0,
+    smooth_s: float = 0.1,
+    min_duration_s: float = 0.4,
+    merge_gap_s: float = 0.0,
+    trim_s: float | None = None,
+    acc_std_threshold_g: float | None = None,
+    offset=None,
+    trigger_window_s: float = 0.4,
+) -> np.ndarray:
     r"""Still periods of a calibration recording.
 
     With a ``trigger`` channel, the ``trigger_window_s`` before each rising edge
-    (:func:`static_intervals_from_trigger`). Otherwise: (1) subtract a first-pass gyro
-    offset (``offset`` or :func:`robust_gyro_offset`); (2) smooth the angular speed
-    :math:`\|\omega - o\|` with a ``smooth_s`` moving average; (3) keep samples below
-    ``threshold`` (and, if ``acc`` and ``acc_std_threshold`` are given, whose moving
-    standard deviation of :math:`\|a\|` is below it); (4) merge runs separated by less
-    than ``merge_gap_s``, shrink each run by ``trim_s`` at both ends (default half the
-    smoothing window, which the moving average spreads into the movement) and drop runs
-    shorter than ``min_duration_s``.
+    (:func:`static_intervals_from_trigger`). Otherwise: (1) convert the gyroscope to
+    °/s and subtract a first-pass offset (``offset`` or :func:`robust_gyro_offset`);
+    (2)–(5) the still-period detector :func:`tiltlab.dsp.still_mask` on the angular
+    speed :math:`\|\omega - o\|`: smoothing by a ``smooth_s`` moving average, samples
+    below ``threshold_deg_s`` (and, if ``acc_std_threshold_g`` is given, whose moving
+    standard deviation of :math:`\|a\|` is below it), merging of runs separated by
+    less than ``merge_gap_s``, trimming of ``trim_s`` at both ends of each run (default
+    half the smoothing window, which the moving average spreads into the movement),
+    removal of runs shorter than ``min_duration_s``.
 
     Parameters
     ----------
-    gyr : array_like (N, 3)
-        Angular velocity in °/s (thresholds are in °/s).
-    fs : float
-        Sampling rate (Hz).
-    acc : array_like (N, 3), optional
-        Acceleration (g), for the optional acceleration criterion.
-    trigger : array_like (N,), optional
+    gyr : Recording, DataArray or array_like (N, 3)
+        Angular velocity (a Recording's ``gyr``). Labelled input carries its units
+        (°/s or rad/s: the thresholds are converted); a plain array is in ``units``,
+        default °/s.
+    fs : float, optional
+        Sampling rate (Hz); read from the attrs of labelled input, mandatory for a
+        plain array.
+    units : str, optional
+        Units of a plain-array ``gyr`` (``"deg/s"`` if not given); for labelled input
+        it must agree with the attrs.
+    acc : Recording, DataArray or array_like (N, 3), optional
+        Acceleration, for the optional acceleration criterion (labelled: converted to
+        g; plain: in g). Default: the Recording's ``acc`` when ``gyr`` is a Recording.
+    trigger : DataArray or array_like (N,), optional
         Trigger channel; when given, thresholds are not used.
-    threshold : float
+    threshold_deg_s : float
         Angular-speed threshold (°/s) on the offset-corrected, smoothed norm.
     smooth_s, min_duration_s, merge_gap_s, trim_s : float
         Durations in seconds.
-    acc_std_threshold : float, optional
-        Maximum moving standard deviation of ‖a‖ (g).
+    acc_std_threshold_g : float, optional
+        Largest moving standard deviation of ‖a‖ (g) at rest.
     offset : array_like (3,), optional
-        Gyro offset to subtract instead of the robust first pass.
+        Gyro offset, in the units of ``gyr``, to subtract instead of the robust first
+        pass.
+    trigger_window_s : float
+        Duration of each trigger-defined still period (s).
 
     Returns
     -------
     ndarray (P, 2)
         ``[start, stop)`` sample indices of the still periods.
     """
-    fs = check_fs(fs)
-    g = vec3(gyr, "gyr", ndim=2)
+    s, factor = read_in(gyr, "gyr", "deg/s", fs=fs, units=units)
+    g, fs = s.values, s.fs
     if trigger is not None:
-        tr = np.asarray(trigger, dtype=float)
-        if tr.shape != (g.shape[0],):
-            raise ValueError(f"trigger must have shape ({g.shape[0]},), got {tr.shape}")
-        return static_intervals_from_trigger(tr, fs, window_s=trigger_window_s)
-    if threshold <= 0:
-        raise ValueError("threshold must be positive (°/s)")
-    o = robust_gyro_offset(g, fs) if offset is None else vec3(offset, "offset", ndim=1)
-    w = max(int(round(smooth_s * fs)), 1)
-    speed = uniform_filter1d(np.linalg.norm(g - o, axis=1), w, mode="nearest")
-    still = speed < threshold
-    if acc is not None and acc_std_threshold is not None:
-        a = vec3(acc, "acc", ndim=2)
-        if a.shape != g.shape:
-            raise ValueError("acc and gyr must have the same shape")
-        an = np.linalg.norm(a, axis=1)
-        m1 = uniform_filter1d(an, w, mode="nearest")
-        m2 = uniform_filter1d(an * an, w, mode="nearest")
-        still &= np.sqrt(np.maximum(m2 - m1 * m1, 0.0)) < acc_std_threshold
-    iv = mask_to_intervals(still, merge_gap=int(round(merge_gap_s * fs)))
-    trim = int(round((0.5 * smooth_s if trim_s is None else trim_s) * fs))
-    iv = iv + np.array([trim, -trim])
-    return iv[(iv[:, 1] - iv[:, 0]) >= max(int(round(min_duration_s * fs)), 1)]
+        tr = _v.signal(trigger, "trigger", fs=fs, width=None, ndim=1)
+        if tr.values.shape != (g.shape[0],):
+            raise ValueError(
+                f"trigger must have shape ({g.shape[0]},), got {tr.values.shape}"
+            )
+        return static_intervals_from_trigger(tr.values, fs, window_s=trigger_window_s)
+    smooth_s = _v.nonnegative(smooth_s, "smooth_s")
+    trim_s = 0.5 * smooth_s if trim_s is None else _v.nonnegative(trim_s, "trim_s")
+    if offset is None:
+        o = robust_gyro_offset(g, fs)
+    else:
+        o = vec3(offset, "offset", ndim=1) * factor
+    acc_norm = None
+    if acc_std_threshold_g is not None:
+        acc_std_threshold_g = _v.positive(acc_std_threshold_g, "acc_std_threshold_g")
+        if acc is None and isinstance(gyr, xr.Dataset):
+            acc = gyr
+        if acc is None:
+            raise ValueError("acc_std_threshold_g needs acc (the acceleration)")
+        a, _ = read_in(acc, "acc", "g", fs=fs, need_fs=False)
+        if a.values.shape != g.shape:
+            raise ValueError(
+                f"acc and gyr must have the same shape, got {a.values.shape} and {g.shape}"
+            )
+        acc_norm = np.linalg.norm(a.values, axis=1)
+    mask = still_mask(
+        np.linalg.norm(g - o, axis=1),
+        fs,
+        threshold=_v.positive(threshold_deg_s, "threshold_deg_s"),
+        smooth_s=smooth_s,
+        acc_norm=acc_norm,
+        acc_std_threshold=acc_std_threshold_g,
+        merge_gap_s=merge_gap_s,
+        min_duration_s=min_duration_s,
+        trim_s=trim_s,
+    )
+    return mask_to_intervals(mask)
 
 
 class StaticStats(NamedTuple):
@@ -185,13 +268,24 @@ class StaticStats(NamedTuple):
     n: np.ndarray
 
 
-def static_means(x, intervals, *, full_scale: float | None = None, min_periods: int = 1) -> StaticStats:
+def static_means(
+    x,
+    intervals,
+    *,
+    var: str = "acc",
+    full_scale: float | None = None,
+    min_periods: int = 1,
+) -> StaticStats:
     """Mean, standard error and standard deviation of a 3-axis signal in each still period.
 
     Parameters
     ----------
-    x : array_like (N, 3)
+    x : Recording, DataArray or array_like (N, 3)
+        The signal (for a Recording, its variable ``var``); statistics are in its units.
     intervals : array_like (P, 2)
+        ``[start, stop)`` sample indices (e.g. from :func:`detect_static`).
+    var : str
+        Variable read from a Recording.
     full_scale : float, optional
         Sensor full scale in the units of ``x``; a period containing a sample within
         0.1 % of it is saturated and raises :class:`CalibrationError` (a clipped mean
@@ -204,38 +298,56 @@ def static_means(x, intervals, *, full_scale: float | None = None, min_periods: 
     The standard error assumes independent samples (white noise); with coloured noise it
     is optimistic.
     """
-    a = vec3(x, "x", ndim=2)
+    a = _v.signal(x, "x", var=var, need_fs=False).values
     iv = _check_intervals(intervals, a.shape[0])
+    if full_scale is not None:
+        full_scale = _v.positive(full_scale, "full_scale")
+    min_periods = _v.integer(min_periods, "min_periods", minimum=0)
     if iv.shape[0] < min_periods:
-        raise CalibrationError(f"found {iv.shape[0]} still periods, at least {min_periods} are needed")
+        raise CalibrationError(
+            f"found {iv.shape[0]} still periods, at least {min_periods} are needed"
+        )
     means, sems, stds, ns = [], [], [], []
     for k, (s, e) in enumerate(iv):
         seg = a[s:e]
         if full_scale is not None and np.any(np.abs(seg) >= 0.999 * full_scale):
-            raise CalibrationError(f"still period {k} (samples {s}:{e}) contains saturated samples "
-                                   f"(|x| reaches the full scale {full_scale})")
+            raise CalibrationError(
+                f"still period {k} (samples {s}:{e}) contains saturated samples "
+                f"(|x| reaches the full scale {full_scale})"
+            )
         n = seg.shape[0]
         sd = seg.std(axis=0, ddof=1) if n > 1 else np.full(3, np.nan)
         means.append(seg.mean(axis=0))
         stds.append(sd)
         sems.append(sd / np.sqrt(n))
         ns.append(n)
-    return StaticStats(np.array(means).reshape(-1, 3), np.array(sems).reshape(-1, 3),
-                       np.array(stds).reshape(-1, 3), np.array(ns, dtype=np.int64))
+    return StaticStats(
+        np.array(means).reshape(-1, 3),
+        np.array(sems).reshape(-1, 3),
+        np.array(stds).reshape(-1, 3),
+        np.array(ns, dtype=np.int64),
+    )
 
 
 def gyro_offset(gyr, intervals) -> tuple[np.ndarray, np.ndarray]:
     """Gyroscope offset as the median angular velocity during still periods (Fayat §2.5).
 
+    Parameters
+    ----------
+    gyr : Recording, DataArray or array_like (N, 3)
+        Angular velocity (a Recording's ``gyr``).
+    intervals : array_like (P, 2)
+        Still periods, ``[start, stop)`` sample indices.
+
     Returns
     -------
     offset : ndarray (3,)
-        Median of all still samples.
+        Median of all still samples, in the units of ``gyr``.
     stderr : ndarray (3,)
         Standard error: the larger of the spread of per-period medians over √P (P ≥ 2)
         and the white-noise standard error of a median, 1.2533 σ/√n.
     """
-    g = vec3(gyr, "gyr", ndim=2)
+    g = _v.signal(gyr, "gyr", need_fs=False).values
     iv = _check_intervals(intervals, g.shape[0])
     if iv.shape[0] == 0:
         raise CalibrationError("no still period: cannot estimate gyroscope offsets")

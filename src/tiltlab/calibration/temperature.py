@@ -16,10 +16,18 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+import xarray as xr
 
-from ._util import CalibrationError, vec3
+from .. import _validate as _v
+from .. import units as _units
+from ._util import CalibrationError, read_temp_degc, vec3
 
-__all__ = ["TemperatureModel", "fit_temperature_model", "compensate_temperature", "offsets_vs_temperature"]
+__all__ = [
+    "TemperatureModel",
+    "fit_temperature_model",
+    "compensate_temperature",
+    "offsets_vs_temperature",
+]
 
 
 @dataclass(frozen=True)
@@ -34,7 +42,7 @@ class TemperatureModel:
         Centring temperature (°C).
     t_range : tuple (min, max)
         Temperatures covered by the fit; :meth:`__call__` refuses to extrapolate beyond
-        ``extrapolate`` °C outside it.
+        ``extrapolate_degc`` °C outside it.
     units : str
         Units of the offsets (``"g"`` or ``"deg/s"``).
     """
@@ -44,28 +52,51 @@ class TemperatureModel:
     t_range: tuple
     units: str
 
-    def __call__(self, temp, *, extrapolate: float = 2.0) -> np.ndarray:
-        """Offsets (N, 3) at temperatures ``temp`` (°C)."""
-        t = np.asarray(temp, dtype=float)
-        if not np.all(np.isfinite(t)):
-            raise ValueError("temperature contains NaN or infinite values")
+    def __call__(self, temp, *, extrapolate_degc: float = 2.0) -> np.ndarray:
+        """Offsets (N, 3) at temperatures ``temp`` (°C; or a labelled ``temp`` in K).
+
+        Temperatures more than ``extrapolate_degc`` (°C) outside the calibrated range
+        raise :class:`CalibrationError`.
+        """
+        if isinstance(temp, xr.DataArray):
+            t = read_temp_degc(temp)
+        else:
+            t = np.asarray(temp, dtype=float)
+            if not np.all(np.isfinite(t)):
+                raise ValueError("temp contains NaN or infinite values")
+        extrapolate_degc = _v.nonnegative(extrapolate_degc, "extrapolate_degc")
         lo, hi = self.t_range
-        if t.size and (t.min() < lo - extrapolate or t.max() > hi + extrapolate):
-            raise CalibrationError(f"temperatures {t.min():.2f}…{t.max():.2f} °C lie outside the calibrated range "
-                                   f"{lo:.2f}…{hi:.2f} °C (± {extrapolate} °C)")
+        if t.size and (
+            t.min() < lo - extrapolate_degc or t.max() > hi + extrapolate_degc
+        ):
+            raise CalibrationError(
+                f"temperatures {t.min():.2f}…{t.max():.2f} °C lie outside the calibrated "
+                f"range {lo:.2f}…{hi:.2f} °C (± extrapolate_degc = {extrapolate_degc} °C)"
+            )
         x = t - self.t0
         return np.stack([np.polyval(np.asarray(c), x) for c in self.coef], axis=-1)
 
     def to_dict(self) -> dict:
-        return {"coef": [list(map(float, c)) for c in self.coef], "t0": float(self.t0),
-                "t_range": [float(v) for v in self.t_range], "units": self.units}
+        return {
+            "coef": [list(map(float, c)) for c in self.coef],
+            "t0": float(self.t0),
+            "t_range": [float(v) for v in self.t_range],
+            "units": self.units,
+        }
 
     @classmethod
     def from_dict(cls, d: dict) -> "TemperatureModel":
-        return cls(tuple(tuple(c) for c in d["coef"]), float(d["t0"]), tuple(d["t_range"]), str(d["units"]))
+        return cls(
+            tuple(tuple(c) for c in d["coef"]),
+            float(d["t0"]),
+            tuple(d["t_range"]),
+            str(d["units"]),
+        )
 
 
-def fit_temperature_model(temp, offsets, *, degree: int = 3, units: str = "g") -> TemperatureModel:
+def fit_temperature_model(
+    temp, offsets, *, degree: int = 3, units: str = "g"
+) -> TemperatureModel:
     """Fit per-axis polynomial offsets against temperature (cubic by default, Fayat Fig. 1d).
 
     Parameters
@@ -80,48 +111,92 @@ def fit_temperature_model(temp, offsets, *, degree: int = 3, units: str = "g") -
     units : str
         Units of the offsets.
     """
-    t = np.asarray(temp, dtype=float)
     o = vec3(offsets, "offsets", ndim=2)
-    if t.shape != (o.shape[0],):
-        raise ValueError(f"temp must have shape ({o.shape[0]},), got {t.shape}")
-    if not np.all(np.isfinite(t)):
-        raise ValueError("temp contains NaN or infinite values")
-    if degree < 0:
-        raise ValueError("degree must be >= 0")
+    t = read_temp_degc(temp, o.shape[0])
+    degree = _v.integer(degree, "degree", minimum=0)
+    units = _units.normalise_unit(units)
     if np.unique(np.round(t, 6)).size < degree + 2:
-        raise CalibrationError(f"a degree-{degree} temperature model needs calibrations at >= {degree + 2} distinct "
-                               f"temperatures, got {np.unique(np.round(t, 6)).size}")
+        raise CalibrationError(
+            f"a degree-{degree} temperature model needs calibrations at >= {degree + 2} distinct "
+            f"temperatures, got {np.unique(np.round(t, 6)).size}"
+        )
     t0 = float(t.mean())
     coef = tuple(tuple(np.polyfit(t - t0, o[:, i], degree)) for i in range(3))
     return TemperatureModel(coef, t0, (float(t.min()), float(t.max())), units)
 
 
-def compensate_temperature(x, temp, model: TemperatureModel) -> np.ndarray:
-    """Subtract temperature-dependent offsets: ``x - model(temp)`` (new array)."""
-    a = vec3(x, "x", ndim=2)
-    t = np.asarray(temp, dtype=float)
-    if t.shape != (a.shape[0],):
-        raise ValueError(f"temp must have shape ({a.shape[0]},), got {t.shape}")
-    return a - model(t)
+def compensate_temperature(x, temp, model: TemperatureModel):
+    """Subtract temperature-dependent offsets: ``x - model(temp)`` (new array).
+
+    Parameters
+    ----------
+    x : DataArray or array_like (N, 3)
+        Readings; labelled input in any units convertible from the model's (the offsets
+        are converted), a plain array in the model's units.
+    temp : DataArray or array_like (N,)
+        Sensor temperature (°C; or a labelled one in K).
+    model : TemperatureModel
+
+    Returns
+    -------
+    ndarray or DataArray (N, 3)
+    """
+    if not isinstance(model, TemperatureModel):
+        raise TypeError(f"model must be a TemperatureModel, got {type(model).__name__}")
+    s = _v.signal(x, "x", need_fs=False)
+    factor = 1.0 if s.units is None else _units.conversion_factor(model.units, s.units)
+    t = read_temp_degc(temp, s.values.shape[0])
+    return _v.labelled(s.values - model(t) * factor, s, "x", units=s.units)
 
 
-def offsets_vs_temperature(x, temp, fs: float, *, window_s: float = 10.0) -> tuple[np.ndarray, np.ndarray]:
+def offsets_vs_temperature(
+    x, temp=None, fs: float | None = None, *, var: str = "gyr", window_s: float = 10.0
+) -> tuple[np.ndarray, np.ndarray]:
     """Offsets of a *static* record in consecutive windows, with the mean temperature of each.
 
     For a gyroscope at rest (true rate 0) the window medians are the offsets; use this on
-    a warm-up record to collect (temperature, offset) pairs for :func:`fit_temperature_model`.
+    a warm-up record to collect (temperature, offset) pairs for
+    :func:`fit_temperature_model`.
+
+    Parameters
+    ----------
+    x : Recording, DataArray or array_like (N, 3)
+        The static record (for a Recording, its variable ``var``).
+    temp : DataArray or array_like (N,), optional
+        Sensor temperature (°C, or labelled in K); default the Recording's ``temp``.
+    fs : float, optional
+        Sampling rate (Hz); read from the attrs of labelled input, mandatory for a
+        plain array.
+    var : str
+        Variable read from a Recording.
+    window_s : float
+        Window length (s).
 
     Returns
     -------
     temps : ndarray (K,)
+        Mean temperature (°C) of each window.
     offsets : ndarray (K, 3)
+        Median of each window, in the units of ``x``.
     """
-    a = vec3(x, "x", ndim=2)
-    t = np.asarray(temp, dtype=float)
-    if t.shape != (a.shape[0],):
-        raise ValueError("temp must have one value per sample")
-    w = int(round(window_s * float(fs)))
+    s = _v.signal(x, "x", var=var, fs=fs)
+    a = s.values
+    if temp is None:
+        if not isinstance(x, xr.Dataset):
+            raise ValueError("temp (the sensor temperature) is needed")
+        if "temp" not in x:
+            raise _v.RecordingError(
+                "the Recording has no variable 'temp' (needed for temp)"
+            )
+        temp = x["temp"]
+    t = read_temp_degc(temp, a.shape[0])
+    window_s = _v.positive(window_s, "window_s")
+    w = max(int(round(window_s * s.fs)), 1)
     k = a.shape[0] // w
     if k < 1:
-        raise CalibrationError("record shorter than one window")
-    return t[: k * w].reshape(k, w).mean(axis=1), np.median(a[: k * w].reshape(k, w, 3), axis=1)
+        raise CalibrationError(
+            f"the record ({a.shape[0]} samples) is shorter than one window of "
+            f"window_s = {window_s:g} s"
+        )
+    temps = t[: k * w].reshape(k, w).mean(axis=1)
+    return temps, np.median(a[: k * w].reshape(k, w, 3), axis=1)

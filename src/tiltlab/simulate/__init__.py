@@ -10,6 +10,9 @@
   (:func:`mocap_markers`, :func:`simulate_mocap_session`);
 * :mod:`~tiltlab.simulate.cohort` — lesion cohorts on disk
   (:func:`simulate_cohort`, :func:`load_cohort`);
+* :mod:`~tiltlab.simulate.track` — bio-logging demonstrations: 3-D tracks for dead
+  reckoning and flapping/gliding heave (:func:`simulate_track`, :func:`simulate_heave`).
+
 The statistics that compare simulated with real recordings live in
 :mod:`tiltlab.behavior` (:func:`~tiltlab.behavior.realism_table`).
 
@@ -18,7 +21,15 @@ ground truth (``q_ref``, ``a_lin``, ``state``, ``true_*`` attrs) and is bit-iden
 for a given seed.
 """
 
-from .kinematics import STATES, BehaviourParams, Lesion, TrueMotion, behaviour_bouts, head_kinematics, target_tilt
+from .kinematics import (
+    STATES,
+    BehaviourParams,
+    Lesion,
+    TrueMotion,
+    behaviour_bouts,
+    head_kinematics,
+    target_tilt,
+)
 from .sensor import (
     ACC_OFFSET_RANGE_G,
     GYR_OFFSET_RANGE_DPS,
@@ -31,7 +42,12 @@ from .sensor import (
     true_sensor_values,
 )
 from .tumble import stage_angles, stage_quaternion, tumble_test, zoh_angular_velocity
-from .mocap import MarkerSupport, head_frame_from_markers, mocap_markers, simulate_mocap_session
+from .mocap import (
+    MarkerSupport,
+    head_frame_from_markers,
+    mocap_markers,
+    simulate_mocap_session,
+)
 from .cohort import (
     ANAESTHESIA,
     EFFECTS,
@@ -45,13 +61,45 @@ from .cohort import (
     session_plan,
     simulate_cohort,
 )
+from .track import Track, simulate_heave, simulate_track
 
 __all__ = [
-    "STATES", "BehaviourParams", "Lesion", "TrueMotion", "behaviour_bouts", "head_kinematics", "target_tilt",
-    "ACC_OFFSET_RANGE_G", "GYR_OFFSET_RANGE_DPS", "SensorModel", "apply_sensor_model", "draw_sensor", "magnetometer_readings",
-    "recording_from_motion", "simulate_session", "true_sensor_values",
-    "stage_angles", "stage_quaternion", "tumble_test", "zoh_angular_velocity",
-    "MarkerSupport", "head_frame_from_markers", "mocap_markers", "simulate_mocap_session",
-    "ANAESTHESIA", "EFFECTS", "FAYAT_GROUPS", "HOURS", "TIME_POINTS", "Cohort", "CohortDesign",
-    "iter_sessions", "load_cohort", "session_plan", "simulate_cohort",
+    "STATES",
+    "BehaviourParams",
+    "Lesion",
+    "TrueMotion",
+    "behaviour_bouts",
+    "head_kinematics",
+    "target_tilt",
+    "ACC_OFFSET_RANGE_G",
+    "GYR_OFFSET_RANGE_DPS",
+    "SensorModel",
+    "apply_sensor_model",
+    "draw_sensor",
+    "magnetometer_readings",
+    "recording_from_motion",
+    "simulate_session",
+    "true_sensor_values",
+    "stage_angles",
+    "stage_quaternion",
+    "tumble_test",
+    "zoh_angular_velocity",
+    "MarkerSupport",
+    "head_frame_from_markers",
+    "mocap_markers",
+    "simulate_mocap_session",
+    "ANAESTHESIA",
+    "EFFECTS",
+    "FAYAT_GROUPS",
+    "HOURS",
+    "TIME_POINTS",
+    "Cohort",
+    "CohortDesign",
+    "iter_sessions",
+    "load_cohort",
+    "session_plan",
+    "simulate_cohort",
+    "Track",
+    "simulate_track",
+    "simulate_heave",
 ]

@@ -71,7 +71,13 @@ __all__ = [
 
 TIME_POINTS: tuple[str, ...] = ("baseline", "1h", "1d", "2d", "7d", "14d", "28d")
 HOURS: tuple[float, ...] = (-1.0, 1.0, 24.0, 48.0, 168.0, 336.0, 672.0)
-FAYAT_GROUPS: dict[str, int] = {"Kainate": 20, "ShamKainate": 11, "Arsanilate": 11, "ShamArsanilate": 5, "Healthy": 11}
+FAYAT_GROUPS: dict[str, int] = {
+    "Kainate": 20,
+    "ShamKainate": 11,
+    "Arsanilate": 11,
+    "ShamArsanilate": 5,
+    "Healthy": 11,
+}
 
 #: Effect of anaesthesia (all groups) per time point: added immobility fraction and
 #: mobility multiplier.
@@ -102,16 +108,23 @@ EFFECTS: dict[str, dict[str, tuple[float, ...]]] = {
     "ShamKainate": {
         "immobility": (0.0, 0.03, 0.02, 0.0, 0.0, 0.0, 0.0),
         "mobility": (1.0, 0.95, 1.0, 1.0, 1.0, 1.0, 1.0),
-        "tilt_deg": (0.0,) * 7, "pitch_deg": (0.0,) * 7, "circling_cpm": (0.0,) * 7,
+        "tilt_deg": (0.0,) * 7,
+        "pitch_deg": (0.0,) * 7,
+        "circling_cpm": (0.0,) * 7,
     },
     "ShamArsanilate": {
         "immobility": (0.0, 0.03, 0.02, 0.0, 0.0, 0.0, 0.0),
         "mobility": (1.0, 0.95, 1.0, 1.0, 1.0, 1.0, 1.0),
-        "tilt_deg": (0.0,) * 7, "pitch_deg": (0.0,) * 7, "circling_cpm": (0.0,) * 7,
+        "tilt_deg": (0.0,) * 7,
+        "pitch_deg": (0.0,) * 7,
+        "circling_cpm": (0.0,) * 7,
     },
     "Healthy": {
-        "immobility": (0.0,) * 7, "mobility": (1.0,) * 7, "tilt_deg": (0.0,) * 7,
-        "pitch_deg": (0.0,) * 7, "circling_cpm": (0.0,) * 7,
+        "immobility": (0.0,) * 7,
+        "mobility": (1.0,) * 7,
+        "tilt_deg": (0.0,) * 7,
+        "pitch_deg": (0.0,) * 7,
+        "circling_cpm": (0.0,) * 7,
     },
 }
 
@@ -145,7 +158,9 @@ class CohortDesign:
     time_points: tuple = TIME_POINTS
     hours: tuple = HOURS
     effects: dict = field(default_factory=lambda: json.loads(json.dumps(EFFECTS)))
-    anaesthesia: dict = field(default_factory=lambda: json.loads(json.dumps(ANAESTHESIA)))
+    anaesthesia: dict = field(
+        default_factory=lambda: json.loads(json.dumps(ANAESTHESIA))
+    )
     lesion_side: str = "left"
     baseline_immobility: float = 0.30
     baseline_immobility_sd: float = 0.06
@@ -164,10 +179,18 @@ class CohortDesign:
             raise ValueError("lesion_side must be 'left' or 'right'")
         for g, n in self.groups.items():
             if int(n) != n or n < 0:
-                raise ValueError(f"group {g!r}: number of animals must be a non-negative integer")
+                raise ValueError(
+                    f"group {g!r}: number of animals must be a non-negative integer"
+                )
             if g not in self.effects:
                 raise ValueError(f"group {g!r} has no entry in effects")
-            for feat in ("immobility", "mobility", "tilt_deg", "pitch_deg", "circling_cpm"):
+            for feat in (
+                "immobility",
+                "mobility",
+                "tilt_deg",
+                "pitch_deg",
+                "circling_cpm",
+            ):
                 v = self.effects[g].get(feat)
                 if v is None or len(v) != nt:
                     raise ValueError(f"effects[{g!r}][{feat!r}] needs {nt} values")
@@ -194,7 +217,9 @@ def _subjects(design: CohortDesign) -> list[tuple[str, str]]:
     return out
 
 
-def session_plan(design: CohortDesign, *, seed: int, duration_s: float, fs: float) -> pd.DataFrame:
+def session_plan(
+    design: CohortDesign, *, seed: int, duration_s: float, fs: float
+) -> pd.DataFrame:
     """One row per session with its planted parameters (no simulation).
 
     Per-animal draws use ``SeedSequence([seed, animal])`` and per-session draws
@@ -205,7 +230,13 @@ def session_plan(design: CohortDesign, *, seed: int, duration_s: float, fs: floa
     sgn = 1.0 if design.lesion_side == "left" else -1.0
     for a, (subj, grp) in enumerate(_subjects(design)):
         arng = np.random.default_rng(np.random.SeedSequence([seed, a]))
-        f_base = float(np.clip(arng.normal(design.baseline_immobility, design.baseline_immobility_sd), 0.05, 0.8))
+        f_base = float(
+            np.clip(
+                arng.normal(design.baseline_immobility, design.baseline_immobility_sd),
+                0.05,
+                0.8,
+            )
+        )
         sus = float(np.exp(arng.normal(0.0, design.susceptibility_sd)))
         pitch0 = float(arng.normal(design.baseline_pitch_deg, design.baseline_pitch_sd))
         roll0 = float(arng.normal(0.0, design.baseline_roll_sd))
@@ -213,43 +244,95 @@ def session_plan(design: CohortDesign, *, seed: int, duration_s: float, fs: floa
         eff = design.effects[grp]
         for t, (tp, hr) in enumerate(zip(design.time_points, design.hours)):
             srng = np.random.default_rng(np.random.SeedSequence([seed, a, t, 1]))
-            imm = f_base + design.anaesthesia["immobility"][t] + sus * eff["immobility"][t]
-            imm = float(np.clip(imm + srng.normal(0.0, design.session_immobility_sd), 0.03, 0.92))
-            mob = design.anaesthesia["mobility"][t] * (1.0 - sus * (1.0 - eff["mobility"][t]))
+            imm = (
+                f_base
+                + design.anaesthesia["immobility"][t]
+                + sus * eff["immobility"][t]
+            )
+            imm = float(
+                np.clip(
+                    imm + srng.normal(0.0, design.session_immobility_sd), 0.03, 0.92
+                )
+            )
+            mob = design.anaesthesia["mobility"][t] * (
+                1.0 - sus * (1.0 - eff["mobility"][t])
+            )
             mob = float(np.clip(mob, 0.2, 1.3))
             tilt = sus * eff["tilt_deg"][t]
-            tilt = tilt + (srng.normal(0.0, design.session_tilt_sd) if tilt > 0 else 0.0)
+            tilt = tilt + (
+                srng.normal(0.0, design.session_tilt_sd) if tilt > 0 else 0.0
+            )
             # a tilt point at T from the sagittal plane needs sin T <= cos(pitch): keep it reachable
             pitch = pitch0 + sus * eff["pitch_deg"][t]
-            t_max = math.degrees(math.asin(math.cos(math.radians(pitch)))) - abs(roll0) - 2.0
+            t_max = (
+                math.degrees(math.asin(math.cos(math.radians(pitch))))
+                - abs(roll0)
+                - 2.0
+            )
             tilt = float(np.clip(tilt, 0.0, min(55.0, t_max)))
-            rows.append({
-                "subject": subj, "group": grp, "time_point": tp, "hours": float(hr),
-                "file": f"sessions/{subj}_{tp}.nc", "animal_index": a, "session_index": t,
-                "seed": seed, "duration_s": float(duration_s), "fs": float(fs),
-                "susceptibility": sus, "baseline_pitch_deg": pitch0, "baseline_roll_deg": roll0, "imu_seed": imu_seed,
-                "immobility_planted": imm, "mobility_planted": mob, "tilt_deg_planted": tilt,
-                "pitch_deg_planted": float(sus * eff["pitch_deg"][t]),
-                "circling_cpm_planted": float(sus * eff["circling_cpm"][t]),
-                "lesion_side": design.lesion_side, "side_sign": sgn,
-            })
+            rows.append(
+                {
+                    "subject": subj,
+                    "group": grp,
+                    "time_point": tp,
+                    "hours": float(hr),
+                    "file": f"sessions/{subj}_{tp}.nc",
+                    "animal_index": a,
+                    "session_index": t,
+                    "seed": seed,
+                    "duration_s": float(duration_s),
+                    "fs": float(fs),
+                    "susceptibility": sus,
+                    "baseline_pitch_deg": pitch0,
+                    "baseline_roll_deg": roll0,
+                    "imu_seed": imu_seed,
+                    "immobility_planted": imm,
+                    "mobility_planted": mob,
+                    "tilt_deg_planted": tilt,
+                    "pitch_deg_planted": float(sus * eff["pitch_deg"][t]),
+                    "circling_cpm_planted": float(sus * eff["circling_cpm"][t]),
+                    "lesion_side": design.lesion_side,
+                    "side_sign": sgn,
+                }
+            )
     return pd.DataFrame(rows)
 
 
 def _simulate_one(row: dict, out_dir: str, keep_true: bool) -> dict:
     """Simulate and write one session; returns the realised truth (run in a worker)."""
-    beh = BehaviourParams(baseline_pitch_deg=row["baseline_pitch_deg"], baseline_roll_deg=row["baseline_roll_deg"])
-    lesion = Lesion(tilt_deg=row["tilt_deg_planted"], pitch_deg=row["pitch_deg_planted"],
-                    circling_cpm=row["circling_cpm_planted"], immobility_fraction=row["immobility_planted"],
-                    mobility=row["mobility_planted"], side=row["lesion_side"])
+    beh = BehaviourParams(
+        baseline_pitch_deg=row["baseline_pitch_deg"],
+        baseline_roll_deg=row["baseline_roll_deg"],
+    )
+    lesion = Lesion(
+        tilt_deg=row["tilt_deg_planted"],
+        pitch_deg=row["pitch_deg_planted"],
+        circling_cpm=row["circling_cpm_planted"],
+        immobility_fraction=row["immobility_planted"],
+        mobility=row["mobility_planted"],
+        side=row["lesion_side"],
+    )
     # the animal keeps its IMU: sensor errors from the animal's seed, temperatures per session
     sensor = draw_sensor(SensorModel(), np.random.default_rng(row["imu_seed"]))
     sensor = SensorModel(**{**sensor.__dict__, "temp_start": None, "temp_end": None})
-    rng = np.random.default_rng(np.random.SeedSequence([row["seed"], row["animal_index"], row["session_index"], 2]))
-    motion = head_kinematics(row["duration_s"], row["fs"], behaviour=beh, lesion=lesion, rng=rng)
-    attrs = {"subject": row["subject"], "session": row["time_point"], "group": row["group"],
-             "hours_after_lesion": row["hours"], "lesion_side": row["lesion_side"]}
-    rec = recording_from_motion(motion, rng=rng, sensor=sensor, keep_true=keep_true, attrs=attrs)
+    rng = np.random.default_rng(
+        np.random.SeedSequence(
+            [row["seed"], row["animal_index"], row["session_index"], 2]
+        )
+    )
+    motion = head_kinematics(
+        row["duration_s"], row["fs"], behaviour=beh, lesion=lesion, rng=rng
+    )
+    attrs = {
+        "subject": row["subject"],
+        "session": row["time_point"],
+        "group": row["group"],
+        "hours_after_lesion": row["hours"],
+        "lesion_side": row["lesion_side"],
+    }
+    rec = recording_from_motion(
+        motion, rng=rng, sensor=sensor, keep_true=keep_true, attrs=attrs
+    )
     _io.save_netcdf(rec, Path(out_dir) / row["file"])
     # realised truth from the true motion
     active = motion.state != 0
@@ -266,9 +349,15 @@ def _simulate_one(row: dict, out_dir: str, keep_true: bool) -> dict:
         "n_samples": int(len(motion)),
         "immobility_realised": float(np.mean(~active)),
         "fraction_below_12dps_true": float(np.mean(speed < 12.0)),
-        "tilt_to_xz_deg_true": float(np.degrees(np.arcsin(np.clip(-row["side_sign"] * g[1], -1, 1)))),
-        "tilt_to_xz_deg_realised": float(np.degrees(np.arcsin(np.clip(-row["side_sign"] * mu[1], -1, 1)))),
-        "baseline_tilt_x": float(g[0]), "baseline_tilt_y": float(g[1]), "baseline_tilt_z": float(g[2]),
+        "tilt_to_xz_deg_true": float(
+            np.degrees(np.arcsin(np.clip(-row["side_sign"] * g[1], -1, 1)))
+        ),
+        "tilt_to_xz_deg_realised": float(
+            np.degrees(np.arcsin(np.clip(-row["side_sign"] * mu[1], -1, 1)))
+        ),
+        "baseline_tilt_x": float(g[0]),
+        "baseline_tilt_y": float(g[1]),
+        "baseline_tilt_z": float(g[2]),
         "circling_cpm_realised": float(row["side_sign"] * cpm),
         "true_gyr_offset_mean": json.dumps(rec.attrs["true_gyr_offset_mean"]),
         "true_acc_offset_mean": json.dumps(rec.attrs["true_acc_offset_mean"]),
@@ -332,7 +421,12 @@ def simulate_cohort(
     # compile (or load cached) kernels once here so that workers find them in the cache
     head_kinematics(0.1, fs, seed=0)
     results = []
-    bar = tqdm(total=len(rows), desc="simulating sessions", unit="session", disable=not progress)
+    bar = tqdm(
+        total=len(rows),
+        desc="simulating sessions",
+        unit="session",
+        disable=not progress,
+    )
     if workers == 1:
         for r in rows:
             results.append(_simulate_one(r, str(path), keep_true))
@@ -346,10 +440,19 @@ def simulate_cohort(
     bar.close()
     real = pd.DataFrame(results).set_index("file").loc[plan["file"]].reset_index()
     truth = plan.merge(real, on="file")
-    plan[["subject", "group", "time_point", "hours", "file"]].to_csv(path / "sessions.csv", index=False)
+    plan[["subject", "group", "time_point", "hours", "file"]].to_csv(
+        path / "sessions.csv", index=False
+    )
     truth.to_csv(path / "truth.csv", index=False)
-    meta = {"design": design.to_dict(), "seed": seed, "duration_s": float(duration_s), "fs": float(fs),
-            "states": list(STATES), "n_sessions": len(rows), "generator": "tiltlab.simulate.simulate_cohort"}
+    meta = {
+        "design": design.to_dict(),
+        "seed": seed,
+        "duration_s": float(duration_s),
+        "fs": float(fs),
+        "states": list(STATES),
+        "n_sessions": len(rows),
+        "generator": "tiltlab.simulate.simulate_cohort",
+    }
     (path / "design.json").write_text(json.dumps(meta, indent=1))
     return path
 
@@ -367,14 +470,23 @@ class Cohort:
     def __len__(self) -> int:
         return len(self.sessions)
 
-    def load(self, subject: str, time_point: str, *, validate: bool = True) -> xr.Dataset:
+    def load(
+        self, subject: str, time_point: str, *, validate: bool = True
+    ) -> xr.Dataset:
         """One session's Recording."""
-        sel = self.sessions[(self.sessions.subject == subject) & (self.sessions.time_point == time_point)]
+        sel = self.sessions[
+            (self.sessions.subject == subject)
+            & (self.sessions.time_point == time_point)
+        ]
         if len(sel) != 1:
-            raise KeyError(f"no unique session for subject={subject!r}, time_point={time_point!r}")
+            raise KeyError(
+                f"no unique session for subject={subject!r}, time_point={time_point!r}"
+            )
         return _io.load_netcdf(self.path / sel.iloc[0]["file"], validate=validate)
 
-    def iter_sessions(self, *, validate: bool = True) -> Iterator[tuple[pd.Series, xr.Dataset]]:
+    def iter_sessions(
+        self, *, validate: bool = True
+    ) -> Iterator[tuple[pd.Series, xr.Dataset]]:
         """Yield ``(row, recording)`` for every session, in table order."""
         for _, row in self.sessions.iterrows():
             yield row, _io.load_netcdf(self.path / row["file"], validate=validate)
@@ -387,18 +499,28 @@ def load_cohort(path) -> Cohort:
     table = path / "sessions.csv"
     if not table.is_file():
         raise FileNotFoundError(f"{path}: no sessions.csv, not a cohort directory")
-    sessions = pd.read_csv(table, dtype={"subject": str, "group": str, "time_point": str, "file": str})
+    sessions = pd.read_csv(
+        table, dtype={"subject": str, "group": str, "time_point": str, "file": str}
+    )
     missing = {"subject", "group", "time_point", "file"} - set(sessions.columns)
     if missing:
         raise ValueError(f"{table}: missing column(s) {sorted(missing)}")
     absent = [f for f in sessions["file"] if not (path / f).is_file()]
     if absent:
-        raise FileNotFoundError(f"{path}: {len(absent)} session file(s) missing, e.g. {absent[0]}")
+        raise FileNotFoundError(
+            f"{path}: {len(absent)} session file(s) missing, e.g. {absent[0]}"
+        )
     truth = pd.read_csv(path / "truth.csv") if (path / "truth.csv").is_file() else None
-    design = json.loads((path / "design.json").read_text()) if (path / "design.json").is_file() else {}
+    design = (
+        json.loads((path / "design.json").read_text())
+        if (path / "design.json").is_file()
+        else {}
+    )
     return Cohort(path=path, sessions=sessions, truth=truth, design=design)
 
 
-def iter_sessions(path, *, validate: bool = True) -> Iterator[tuple[pd.Series, xr.Dataset]]:
+def iter_sessions(
+    path, *, validate: bool = True
+) -> Iterator[tuple[pd.Series, xr.Dataset]]:
     """Shortcut for ``load_cohort(path).iter_sessions()``."""
     return load_cohort(path).iter_sessions(validate=validate)

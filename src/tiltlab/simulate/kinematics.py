@@ -55,12 +55,35 @@ __all__ = [
 ]
 
 #: Behavioural state codes (index = code stored in the ``state`` variable).
-STATES: tuple[str, ...] = ("immobile", "explore", "locomotion", "rearing", "grooming", "circling")
+STATES: tuple[str, ...] = (
+    "immobile",
+    "explore",
+    "locomotion",
+    "rearing",
+    "grooming",
+    "circling",
+)
 IMMOBILE, EXPLORE, LOCOMOTION, REARING, GROOMING, CIRCLING = range(6)
 
 # columns of the per-bout parameter table passed to the kernel
-(_PITCH, _ROLL, _POS_SD, _POS_TAU, _YAW_SD, _YAW_TAU, _YAW_BIAS, _JIT_SD, _SPEED, _HEIGHT,
- _GAIT_F, _GAIT_AMP, _BOB, _GROOM_F, _GROOM_AMP, _ACC_SD) = range(16)
+(
+    _PITCH,
+    _ROLL,
+    _POS_SD,
+    _POS_TAU,
+    _YAW_SD,
+    _YAW_TAU,
+    _YAW_BIAS,
+    _JIT_SD,
+    _SPEED,
+    _HEIGHT,
+    _GAIT_F,
+    _GAIT_AMP,
+    _BOB,
+    _GROOM_F,
+    _GROOM_AMP,
+    _ACC_SD,
+) = range(16)
 _NFIELDS = 16
 _D2R = math.pi / 180.0
 #: angular speed (deg/s) of the head during a circling bout (15 circles per minute)
@@ -162,7 +185,13 @@ class BehaviourParams:
 
     immobility_fraction: float = 0.32
     active_bout_s: float = 12.0
-    state_weights: tuple[float, float, float, float, float] = (0.55, 0.20, 0.12, 0.13, 0.0)
+    state_weights: tuple[float, float, float, float, float] = (
+        0.55,
+        0.20,
+        0.12,
+        0.13,
+        0.0,
+    )
     state_mean_s: tuple[float, float, float, float, float] = (2.0, 1.5, 2.0, 4.0, 3.0)
     baseline_pitch_deg: float = 25.0
     baseline_roll_deg: float = 0.0
@@ -180,17 +209,23 @@ class BehaviourParams:
 
     def __post_init__(self):
         if not 0.0 <= self.immobility_fraction < 1.0:
-            raise ValueError(f"immobility_fraction must be in [0, 1), got {self.immobility_fraction}")
+            raise ValueError(
+                f"immobility_fraction must be in [0, 1), got {self.immobility_fraction}"
+            )
         if self.active_bout_s <= 0 or min(self.state_mean_s) <= 0:
             raise ValueError("bout durations must be positive")
         if len(self.state_weights) != 5 or len(self.state_mean_s) != 5:
-            raise ValueError("state_weights and state_mean_s need 5 values (explore, locomotion, rearing, grooming, circling)")
+            raise ValueError(
+                "state_weights and state_mean_s need 5 values (explore, locomotion, rearing, grooming, circling)"
+            )
         if min(self.state_weights) < 0 or sum(self.state_weights) <= 0:
             raise ValueError("state_weights must be non-negative and not all zero")
         if self.mobility <= 0:
             raise ValueError(f"mobility must be > 0, got {self.mobility}")
         if self.tilt_gain <= 0 or self.omega_tau_s <= 0 or self.posture_tau_s <= 0:
-            raise ValueError("tilt_gain, omega_tau_s and posture_tau_s must be positive")
+            raise ValueError(
+                "tilt_gain, omega_tau_s and posture_tau_s must be positive"
+            )
         if abs(self.baseline_pitch_deg) >= 90:
             raise ValueError("baseline_pitch_deg must be within (-90, 90)")
 
@@ -206,10 +241,14 @@ class BehaviourParams:
         pitch = self.baseline_pitch_deg + lesion.pitch_deg
         g0 = target_tilt(math.radians(pitch), math.radians(self.baseline_roll_deg))
         # angle to the xz plane toward the lesion side adds to the animal's own
-        tilt = math.degrees(math.asin(max(-1.0, min(1.0, -sgn * g0[1])))) + lesion.tilt_deg
+        tilt = (
+            math.degrees(math.asin(max(-1.0, min(1.0, -sgn * g0[1])))) + lesion.tilt_deg
+        )
         s = -sgn * math.sin(math.radians(tilt)) / math.cos(math.radians(pitch))
         if abs(s) > 1:
-            raise ValueError(f"tilt {tilt:.1f}° is not reachable with pitch {pitch:.1f}°")
+            raise ValueError(
+                f"tilt {tilt:.1f}° is not reachable with pitch {pitch:.1f}°"
+            )
         roll = math.degrees(math.asin(s))
         return replace(
             self,
@@ -217,16 +256,22 @@ class BehaviourParams:
             baseline_roll_deg=roll,
             circling_cpm=self.circling_cpm + sgn * lesion.circling_cpm,
             mobility=self.mobility * lesion.mobility,
-            immobility_fraction=self.immobility_fraction if lesion.immobility_fraction is None else lesion.immobility_fraction,
+            immobility_fraction=self.immobility_fraction
+            if lesion.immobility_fraction is None
+            else lesion.immobility_fraction,
         )
 
     def baseline_tilt(self) -> np.ndarray:
         """The baseline tilt point ``g0`` (unit vector, sensor frame)."""
-        return target_tilt(math.radians(self.baseline_pitch_deg), math.radians(self.baseline_roll_deg))
+        return target_tilt(
+            math.radians(self.baseline_pitch_deg), math.radians(self.baseline_roll_deg)
+        )
 
     def to_dict(self) -> dict:
         """JSON-serialisable dict of the parameters."""
-        return {k: (list(v) if isinstance(v, tuple) else v) for k, v in asdict(self).items()}
+        return {
+            k: (list(v) if isinstance(v, tuple) else v) for k, v in asdict(self).items()
+        }
 
 
 def target_tilt(pitch, roll) -> np.ndarray:
@@ -237,7 +282,10 @@ def target_tilt(pitch, roll) -> np.ndarray:
     ``R = R_y(β) R_x(γ)``.
     """
     pitch, roll = np.asarray(pitch, float), np.asarray(roll, float)
-    return np.stack([-np.sin(pitch), np.sin(roll) * np.cos(pitch), np.cos(roll) * np.cos(pitch)], axis=-1)
+    return np.stack(
+        [-np.sin(pitch), np.sin(roll) * np.cos(pitch), np.cos(roll) * np.cos(pitch)],
+        axis=-1,
+    )
 
 
 @dataclass
@@ -276,7 +324,9 @@ def _gamma_dur(rng: np.random.Generator, mean: float, minimum: float) -> float:
     return minimum + rng.gamma(2.0, max(mean - minimum, 1e-3) / 2.0)
 
 
-def behaviour_bouts(duration_s: float, params: BehaviourParams, rng: np.random.Generator):
+def behaviour_bouts(
+    duration_s: float, params: BehaviourParams, rng: np.random.Generator
+):
     """Draw the sequence of behavioural bouts and the parameters of each.
 
     Immobile and active episodes alternate; an active episode (mean
@@ -299,17 +349,27 @@ def behaviour_bouts(duration_s: float, params: BehaviourParams, rng: np.random.G
     w = np.array(p.state_weights, float)
     # circling set by circling_cpm: circling bouts take up to 30% of active time, a yaw bias the rest
     c_cpm = p.circling_cpm
-    share_c = min(0.3, 0.6 * abs(c_cpm) / (CIRCLING_SPEED_DPS / 6.0)) if c_cpm else w[4] / w.sum()
+    share_c = (
+        min(0.3, 0.6 * abs(c_cpm) / (CIRCLING_SPEED_DPS / 6.0))
+        if c_cpm
+        else w[4] / w.sum()
+    )
     w = w / w.sum()
     if c_cpm:
         w[:4] = w[:4] / max(w[:4].sum(), 1e-12) * (1.0 - share_c)
         w[4] = share_c
-    w[2] *= m  # rearing and grooming scale with mobility (loss and recovery of repertoire)
+    w[2] *= (
+        m  # rearing and grooming scale with mobility (loss and recovery of repertoire)
+    )
     w[3] *= m
     w = w / w.sum()
     share_c = w[4]
     sgn_c = 1.0 if c_cpm >= 0 else -1.0
-    bias = (abs(c_cpm) - share_c * CIRCLING_SPEED_DPS / 6.0) * 2.0 * math.pi / 60.0 * sgn_c if c_cpm else 0.0
+    bias = (
+        (abs(c_cpm) - share_c * CIRCLING_SPEED_DPS / 6.0) * 2.0 * math.pi / 60.0 * sgn_c
+        if c_cpm
+        else 0.0
+    )
     means = np.array(p.state_mean_s, float)
     pick = w / means
     pick = pick / pick.sum()
@@ -335,20 +395,33 @@ def behaviour_bouts(duration_s: float, params: BehaviourParams, rng: np.random.G
         # vigour of the bout: slow, quiet bouts and brisk ones (log-normal, median 1)
         vig = math.exp(p.vigour_sd * rng.standard_normal()) if p.vigour_sd > 0 else 1.0
         if state == EXPLORE:
-            r[_PITCH], r[_ROLL] = b0 + m * rng.normal(-8.0, 12.0) * _D2R, g0 + m * rng.normal(0, 10.0) * _D2R
+            r[_PITCH], r[_ROLL] = (
+                b0 + m * rng.normal(-8.0, 12.0) * _D2R,
+                g0 + m * rng.normal(0, 10.0) * _D2R,
+            )
             r[_POS_SD], r[_YAW_SD] = m * 24.0 * _D2R, m * 140.0 * _D2R
             r[_SPEED] = 0.04
         elif state in (LOCOMOTION, CIRCLING):
-            r[_PITCH], r[_ROLL] = b0 + m * rng.normal(0, 6.0) * _D2R, g0 + m * rng.normal(0, 4.0) * _D2R
+            r[_PITCH], r[_ROLL] = (
+                b0 + m * rng.normal(0, 6.0) * _D2R,
+                g0 + m * rng.normal(0, 4.0) * _D2R,
+            )
             r[_POS_SD], r[_YAW_SD] = m * 6.0 * _D2R, m * 40.0 * _D2R
             r[_SPEED] = rng.uniform(0.12, 0.28) * math.sqrt(m)
-            r[_GAIT_F], r[_GAIT_AMP], r[_BOB] = rng.uniform(3.0, 5.0), m * 2.5 * _D2R, 0.004
+            r[_GAIT_F], r[_GAIT_AMP], r[_BOB] = (
+                rng.uniform(3.0, 5.0),
+                m * 2.5 * _D2R,
+                0.004,
+            )
             r[_JIT_SD] *= 0.7
             if state == CIRCLING:
                 r[_YAW_BIAS] = bias + sgn_c * CIRCLING_SPEED_DPS * _D2R
                 r[_SPEED] = 0.10
         elif state == REARING:
-            r[_PITCH], r[_ROLL] = b0 + m * rng.normal(-60.0, 10.0) * _D2R, g0 + m * rng.normal(0, 8.0) * _D2R
+            r[_PITCH], r[_ROLL] = (
+                b0 + m * rng.normal(-60.0, 10.0) * _D2R,
+                g0 + m * rng.normal(0, 8.0) * _D2R,
+            )
             r[_POS_SD], r[_YAW_SD] = m * 8.0 * _D2R, m * 35.0 * _D2R
             r[_HEIGHT] = m * rng.uniform(0.06, 0.12)
             r[_JIT_SD] *= 0.7
@@ -358,7 +431,10 @@ def behaviour_bouts(duration_s: float, params: BehaviourParams, rng: np.random.G
             r[_ROLL] = g0 + m * side * rng.uniform(10.0, 35.0) * _D2R
             r[_POS_SD], r[_POS_TAU] = m * 10.0 * _D2R, 0.3
             r[_YAW_SD] = m * 20.0 * _D2R
-            r[_GROOM_F], r[_GROOM_AMP] = rng.uniform(5.0, 8.0), m * rng.uniform(5.0, 8.0) * _D2R
+            r[_GROOM_F], r[_GROOM_AMP] = (
+                rng.uniform(5.0, 8.0),
+                m * rng.uniform(5.0, 8.0) * _D2R,
+            )
             r[_JIT_SD] *= 1.2
         if state in (EXPLORE, LOCOMOTION, REARING):
             r[_POS_SD] *= vig
@@ -389,15 +465,34 @@ def behaviour_bouts(duration_s: float, params: BehaviourParams, rng: np.random.G
                 rows.append(row(s))
                 t += dur
         immobile = not immobile
-    return np.array(starts), np.array(states, dtype=np.int64), np.array(rows).reshape(-1, _NFIELDS)
+    return (
+        np.array(starts),
+        np.array(states, dtype=np.int64),
+        np.array(rows).reshape(-1, _NFIELDS),
+    )
 
 
 # ------------------------------------------------------------------ kernel
 
 
 @njit(cache=True)
-def _kinematics_kernel(n, dt, b_start, table, q0, d, k_tilt, tau_w, tau_p, arena_r, seed,
-                       out_q, out_w, out_a, out_pos):
+def _kinematics_kernel(
+    n,
+    dt,
+    b_start,
+    table,
+    q0,
+    d,
+    k_tilt,
+    tau_w,
+    tau_p,
+    arena_r,
+    seed,
+    out_q,
+    out_w,
+    out_a,
+    out_pos,
+):
     np.random.seed(seed)
     nb = b_start.shape[0]
     w, x, y, z = q0[0], q0[1], q0[2], q0[3]
@@ -426,7 +521,9 @@ def _kinematics_kernel(n, dt, b_start, table, q0, d, k_tilt, tau_w, tau_p, arena
     tau_j = 0.04
     e_j = math.exp(-dt / tau_j)
     s_j = math.sqrt(1.0 - e_j * e_j)
-    wn = 2.0 * math.pi * 1.0  # neck height follows its target as a critically damped 1 Hz system
+    wn = (
+        2.0 * math.pi * 1.0
+    )  # neck height follows its target as a critically damped 1 Hz system
     tau_v = 0.15
     ramp = 0.15
     e_pos = 0.0
@@ -643,20 +740,44 @@ def head_kinematics(
     starts, states, table = behaviour_bouts(n / fs, params, rng)
     b_start = np.round(starts * fs).astype(np.int64)
     keep = np.r_[True, np.diff(b_start) > 0] & (b_start < n)
-    b_start, states, table = b_start[keep], states[keep], np.ascontiguousarray(table[keep])
+    b_start, states, table = (
+        b_start[keep],
+        states[keep],
+        np.ascontiguousarray(table[keep]),
+    )
     heading = rng.uniform(-np.pi, np.pi)
-    b0, g0 = math.radians(params.baseline_pitch_deg), math.radians(params.baseline_roll_deg)
+    b0, g0 = (
+        math.radians(params.baseline_pitch_deg),
+        math.radians(params.baseline_roll_deg),
+    )
     # q0 = R_z(heading) R_y(pitch) R_x(roll): the baseline posture with a random heading
-    q0 = _quat.mul(_quat.from_rotvec([0.0, 0.0, heading]),
-                   _quat.mul(_quat.from_rotvec([0.0, b0, 0.0]), _quat.from_rotvec([g0, 0.0, 0.0])))
+    q0 = _quat.mul(
+        _quat.from_rotvec([0.0, 0.0, heading]),
+        _quat.mul(_quat.from_rotvec([0.0, b0, 0.0]), _quat.from_rotvec([g0, 0.0, 0.0])),
+    )
     kseed = int(rng.integers(0, 2**31 - 1))
     q = np.empty((n, 4))
     w = np.empty((n, 3))
     a = np.empty((n, 3))
     pos = np.empty((n, 3))
     d = np.asarray(params.sensor_from_pivot_m, float)
-    _kinematics_kernel(n, 1.0 / fs, b_start, table, q0, d, params.tilt_gain, params.omega_tau_s,
-                       params.posture_tau_s, params.arena_radius_m, kseed, q, w, a, pos)
+    _kinematics_kernel(
+        n,
+        1.0 / fs,
+        b_start,
+        table,
+        q0,
+        d,
+        params.tilt_gain,
+        params.omega_tau_s,
+        params.posture_tau_s,
+        params.arena_radius_m,
+        kseed,
+        q,
+        w,
+        a,
+        pos,
+    )
     lengths = np.diff(np.r_[b_start, n])
     state = np.repeat(states.astype(np.int8), lengths)
     info = {
@@ -664,4 +785,6 @@ def head_kinematics(
         "baseline_tilt": params.baseline_tilt().tolist(),
         "n_bouts": int(len(b_start)),
     }
-    return TrueMotion(q=q, omega=w, a_lin=a, pos=pos, state=state, fs=float(fs), params=info)
+    return TrueMotion(
+        q=q, omega=w, a_lin=a, pos=pos, state=state, fs=float(fs), params=info
+    )

@@ -36,7 +36,12 @@ from ..frames import head_frame_from_markers
 from .kinematics import BehaviourParams, Lesion, TrueMotion, head_kinematics
 from .sensor import SensorModel, recording_from_motion
 
-__all__ = ["MarkerSupport", "mocap_markers", "simulate_mocap_session", "head_frame_from_markers"]
+__all__ = [
+    "MarkerSupport",
+    "mocap_markers",
+    "simulate_mocap_session",
+    "head_frame_from_markers",
+]
 
 
 @dataclass(frozen=True)
@@ -45,7 +50,12 @@ class MarkerSupport:
     (= sensor) frame, mm, rows = markers 1..4; ``misalign_deg``: standard deviation of
     the random rotation between the marker frame and the IMU axes."""
 
-    markers_mm: tuple = ((0.0, 16.0, 30.0), (0.0, -16.0, 30.0), (35.0, -16.0, 30.0), (18.0, 4.0, 48.0))
+    markers_mm: tuple = (
+        (0.0, 16.0, 30.0),
+        (0.0, -16.0, 30.0),
+        (35.0, -16.0, 30.0),
+        (18.0, 4.0, 48.0),
+    )
     misalign_deg: float = 2.0
 
     def __post_init__(self):
@@ -116,7 +126,11 @@ def mocap_markers(
     # white jitter; each crossing of an integer moves a TTL one IMU sample (5 or 7 per cycle)
     n_cyc = n // ttl_every + 2
     drift = slip_fraction * (1.0 if rng.random() < 0.5 else -1.0)
-    phase_c = rng.uniform(0.0, 1.0) + drift * np.arange(n_cyc) + clock_jitter * rng.standard_normal(n_cyc)
+    phase_c = (
+        rng.uniform(0.0, 1.0)
+        + drift * np.arange(n_cyc)
+        + clock_jitter * rng.standard_normal(n_cyc)
+    )
     j = np.arange(n)
     phase = np.interp(j / ttl_every, np.arange(n_cyc), phase_c)
     u = j + phase  # fractional IMU sample index of each frame
@@ -134,7 +148,9 @@ def mocap_markers(
     q, i0, f = _nlerp(motion.q, u)
     pos = (1 - f) * motion.pos[i0] + f * motion.pos[i0 + 1]
     mis = _quat.from_rotvec(np.radians(sup.misalign_deg) * rng.standard_normal(3))
-    m_s = _quat.rotate(mis, np.asarray(sup.markers_mm, float))  # marker coordinates in the sensor frame
+    m_s = _quat.rotate(
+        mis, np.asarray(sup.markers_mm, float)
+    )  # marker coordinates in the sensor frame
     nm = m_s.shape[0]
     mk = pos[:, None, :] * 1000.0 + _quat.rotate(q[:, None, :], m_s[None, :, :])
     mk = mk + noise_mm * rng.standard_normal(mk.shape)
@@ -144,24 +160,40 @@ def mocap_markers(
         for s in np.flatnonzero(rng.random(n_frames) < reflection_rate):
             L = int(rng.integers(1, 11))
             v = rng.standard_normal(3)
-            mk[s:s + L, k] += rng.uniform(2.0, 5.0) * v / np.linalg.norm(v)
-            gross[s:s + L, k] = True
+            mk[s : s + L, k] += rng.uniform(2.0, 5.0) * v / np.linalg.norm(v)
+            gross[s : s + L, k] = True
         for s in np.flatnonzero(rng.random(n_frames) < occlusion_rate):
             L = int(rng.integers(1, 3))
-            occl[s:s + L, k] = True
+            occl[s : s + L, k] = True
     mk[occl] = np.nan
     gross |= occl
     ds = xr.Dataset(
         {
-            "markers": (("frame", "marker", "axis"), mk, {"units": "mm", "frame": "mocap (world, z up)"}),
-            "gross_error": (("frame", "marker"), gross, {"long_name": "reflection or occlusion (ground truth)"}),
+            "markers": (
+                ("frame", "marker", "axis"),
+                mk,
+                {"units": "mm", "frame": "mocap (world, z up)"},
+            ),
+            "gross_error": (
+                ("frame", "marker"),
+                gross,
+                {"long_name": "reflection or occlusion (ground truth)"},
+            ),
             "occluded": (("frame", "marker"), occl),
-            "t_true": (("frame",), u / fs, {"units": "s", "long_name": "true frame time in the IMU time base"}),
+            "t_true": (
+                ("frame",),
+                u / fs,
+                {"units": "s", "long_name": "true frame time in the IMU time base"},
+            ),
             "q_ref": (("frame", "quat"), q, {"units": "1", "frame": "sensor->world"}),
             "ttl": (("frame",), ttl, {"long_name": "frame emitting a TTL pulse"}),
         },
-        coords={"frame_time": ("frame", j / fs, {"units": "s"}), "marker": np.arange(1, nm + 1),
-                "axis": ["x", "y", "z"], "quat": ["w", "x", "y", "z"]},
+        coords={
+            "frame_time": ("frame", j / fs, {"units": "s"}),
+            "marker": np.arange(1, nm + 1),
+            "axis": ["x", "y", "z"],
+            "quat": ["w", "x", "y", "z"],
+        },
         attrs={
             "fs": float(fs),
             "source": "tiltlab.simulate.mocap_markers",
@@ -192,9 +224,16 @@ def simulate_mocap_session(
     Recording (with a boolean ``sync`` variable marking TTL-bearing samples) and the
     mocap Dataset of :func:`mocap_markers`."""
     rng = np.random.default_rng(seed)
-    motion = head_kinematics(duration_s, fs, behaviour=behaviour, lesion=lesion, rng=rng)
+    motion = head_kinematics(
+        duration_s, fs, behaviour=behaviour, lesion=lesion, rng=rng
+    )
     mocap, sync = mocap_markers(motion, rng=rng, support=support, **mocap_kwargs)
-    rec = recording_from_motion(motion, rng=rng, sensor=sensor, keep_true=True,
-                                attrs={"session": "imu + motion capture"})
+    rec = recording_from_motion(
+        motion,
+        rng=rng,
+        sensor=sensor,
+        keep_true=True,
+        attrs={"session": "imu + motion capture"},
+    )
     rec["sync"] = ("time", sync, {"long_name": "IMU sample registering a video TTL"})
     return rec, mocap

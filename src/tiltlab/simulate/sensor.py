@@ -136,12 +136,26 @@ class SensorModel:
     mag_noise_uT: float = 0.6
 
     def __post_init__(self):
-        for k in ("acc_noise_density", "gyr_noise_density", "acc_bias_walk", "gyr_bias_walk", "mag_noise_uT"):
+        for k in (
+            "acc_noise_density",
+            "gyr_noise_density",
+            "acc_bias_walk",
+            "gyr_bias_walk",
+            "mag_noise_uT",
+        ):
             if getattr(self, k) < 0:
                 raise ValueError(f"{k} must be >= 0")
         if self.acc_range <= 0 or self.gyr_range <= 0:
             raise ValueError("acc_range and gyr_range must be positive")
-        for k in ("acc_offset", "gyr_offset", "acc_scale", "gyr_scale", "acc_temp_coef", "gyr_temp_coef", "mag_hard_iron"):
+        for k in (
+            "acc_offset",
+            "gyr_offset",
+            "acc_scale",
+            "gyr_scale",
+            "acc_temp_coef",
+            "gyr_temp_coef",
+            "mag_hard_iron",
+        ):
             _vec(getattr(self, k), k)
         for k in ("acc_misalign", "gyr_misalign", "mag_soft_iron"):
             _vec(getattr(self, k), k, (3, 3))
@@ -151,15 +165,40 @@ class SensorModel:
         """A perfect sensor: no offset, scale, misalignment, noise, drift, temperature
         effect, saturation or quantisation (measured = true)."""
         z, e = (0.0, 0.0, 0.0), ((0.0,) * 3,) * 3
-        return cls(acc_offset=z, gyr_offset=z, acc_scale=z, gyr_scale=z, acc_misalign=e, gyr_misalign=e,
-                   acc_temp_coef=z, gyr_temp_coef=z, acc_noise_density=0.0, gyr_noise_density=0.0,
-                   acc_bias_walk=0.0, gyr_bias_walk=0.0, acc_range=1e9, gyr_range=1e12, quantize=False,
-                   temp_start=31.0, temp_end=31.0, magnetometer=magnetometer, mag_hard_iron=z,
-                   mag_soft_iron=((1.0, 0, 0), (0, 1.0, 0), (0, 0, 1.0)), mag_noise_uT=0.0)
+        return cls(
+            acc_offset=z,
+            gyr_offset=z,
+            acc_scale=z,
+            gyr_scale=z,
+            acc_misalign=e,
+            gyr_misalign=e,
+            acc_temp_coef=z,
+            gyr_temp_coef=z,
+            acc_noise_density=0.0,
+            gyr_noise_density=0.0,
+            acc_bias_walk=0.0,
+            gyr_bias_walk=0.0,
+            acc_range=1e9,
+            gyr_range=1e12,
+            quantize=False,
+            temp_start=31.0,
+            temp_end=31.0,
+            magnetometer=magnetometer,
+            mag_hard_iron=z,
+            mag_soft_iron=((1.0, 0, 0), (0, 1.0, 0), (0, 0, 1.0)),
+            mag_noise_uT=0.0,
+        )
 
     def to_dict(self) -> dict:
         """JSON-serialisable dict."""
-        return {k: (np.asarray(v).tolist() if isinstance(v, (tuple, list, np.ndarray)) else v) for k, v in asdict(self).items()}
+        return {
+            k: (
+                np.asarray(v).tolist()
+                if isinstance(v, (tuple, list, np.ndarray))
+                else v
+            )
+            for k, v in asdict(self).items()
+        }
 
 
 def _misalign(rng, sd):
@@ -205,11 +244,34 @@ def draw_sensor(sensor: SensorModel | None, rng: np.random.Generator) -> SensorM
         vals["mag_soft_iron"] = np.asarray(s.mag_soft_iron, float)
     t0 = s.temp_start if s.temp_start is not None else float(rng.uniform(27.0, 30.0))
     t1 = s.temp_end if s.temp_end is not None else float(rng.uniform(31.0, 34.0))
-    return replace(s, temp_start=t0, temp_end=t1, **{k: tuple(map(tuple, v)) if v.ndim == 2 else tuple(v) for k, v in vals.items()})
+    return replace(
+        s,
+        temp_start=t0,
+        temp_end=t1,
+        **{
+            k: tuple(map(tuple, v)) if v.ndim == 2 else tuple(v)
+            for k, v in vals.items()
+        },
+    )
 
 
 @njit(cache=True)
-def _measure_kernel(x, T, offset, temp_coef, dtemp, noise_sd, walk_sd, lo, hi, lsb, quantize, seed, out, bias_mean):
+def _measure_kernel(
+    x,
+    T,
+    offset,
+    temp_coef,
+    dtemp,
+    noise_sd,
+    walk_sd,
+    lo,
+    hi,
+    lsb,
+    quantize,
+    seed,
+    out,
+    bias_mean,
+):
     # y = Q(sat(T x + o + c dT + b + n)); b a random walk started at 0
     np.random.seed(seed)
     n = x.shape[0]
@@ -223,7 +285,13 @@ def _measure_kernel(x, T, offset, temp_coef, dtemp, noise_sd, walk_sd, lo, hi, l
     for k in range(n):
         x0, x1, x2 = x[k, 0], x[k, 1], x[k, 2]
         for i in range(3):
-            v = T[i, 0] * x0 + T[i, 1] * x1 + T[i, 2] * x2 + offset[i] + temp_coef[i] * dtemp[k]
+            v = (
+                T[i, 0] * x0
+                + T[i, 1] * x1
+                + T[i, 2] * x2
+                + offset[i]
+                + temp_coef[i] * dtemp[k]
+            )
             if i == 0:
                 v += b0
             elif i == 1:
@@ -254,19 +322,47 @@ def _measure_kernel(x, T, offset, temp_coef, dtemp, noise_sd, walk_sd, lo, hi, l
     return n_sat
 
 
-def _measure(x, scale, misalign, offset_ref, temp_coef, dtemp, noise_sd, walk_sd, rng, full_scale, quantize):
-    T = (np.eye(3) + np.diag(np.asarray(scale, float))) @ (np.eye(3) + np.asarray(misalign, float))
+def _measure(
+    x,
+    scale,
+    misalign,
+    offset_ref,
+    temp_coef,
+    dtemp,
+    noise_sd,
+    walk_sd,
+    rng,
+    full_scale,
+    quantize,
+):
+    T = (np.eye(3) + np.diag(np.asarray(scale, float))) @ (
+        np.eye(3) + np.asarray(misalign, float)
+    )
     lsb = 2.0 * full_scale / 65536.0
     out = np.empty_like(x)
     b = np.zeros(3)
-    n_sat = _measure_kernel(np.ascontiguousarray(x, dtype=float), T, np.asarray(offset_ref, float),
-                            np.asarray(temp_coef, float), dtemp, float(noise_sd), float(walk_sd),
-                            -full_scale, full_scale - lsb, lsb, bool(quantize),
-                            int(rng.integers(0, 2**31 - 1)), out, b)
+    n_sat = _measure_kernel(
+        np.ascontiguousarray(x, dtype=float),
+        T,
+        np.asarray(offset_ref, float),
+        np.asarray(temp_coef, float),
+        dtemp,
+        float(noise_sd),
+        float(walk_sd),
+        -full_scale,
+        full_scale - lsb,
+        lsb,
+        bool(quantize),
+        int(rng.integers(0, 2**31 - 1)),
+        out,
+        b,
+    )
     return out, b, int(n_sat)
 
 
-def apply_sensor_model(true: dict, sensor: SensorModel | None, rng: np.random.Generator, fs: float) -> dict:
+def apply_sensor_model(
+    true: dict, sensor: SensorModel | None, rng: np.random.Generator, fs: float
+) -> dict:
     """Corrupt true sensor-frame signals with a sensor model.
 
     Parameters
@@ -292,7 +388,9 @@ def apply_sensor_model(true: dict, sensor: SensorModel | None, rng: np.random.Ge
     acc = np.asarray(true["acc"], float)
     gyr = np.asarray(true["gyr"], float)
     if acc.ndim != 2 or acc.shape[1] != 3 or gyr.shape != acc.shape:
-        raise ValueError(f"true acc and gyr must both have shape (N, 3), got {acc.shape} and {gyr.shape}")
+        raise ValueError(
+            f"true acc and gyr must both have shape (N, 3), got {acc.shape} and {gyr.shape}"
+        )
     s = draw_sensor(sensor, rng)
     n = acc.shape[0]
     t = np.arange(n) / fs
@@ -300,18 +398,54 @@ def apply_sensor_model(true: dict, sensor: SensorModel | None, rng: np.random.Ge
     dtemp = temp - s.temp_ref
     half_bw = math.sqrt(fs / 2.0)
     sq_dt = math.sqrt(1.0 / fs)
-    acc_m, acc_b, acc_sat = _measure(acc, s.acc_scale, s.acc_misalign, s.acc_offset, s.acc_temp_coef, dtemp,
-                                     s.acc_noise_density * half_bw, s.acc_bias_walk * sq_dt, rng, s.acc_range, s.quantize)
-    gyr_m, gyr_b, gyr_sat = _measure(gyr, s.gyr_scale, s.gyr_misalign, s.gyr_offset, s.gyr_temp_coef, dtemp,
-                                     s.gyr_noise_density * half_bw, s.gyr_bias_walk * sq_dt, rng, s.gyr_range, s.quantize)
+    acc_m, acc_b, acc_sat = _measure(
+        acc,
+        s.acc_scale,
+        s.acc_misalign,
+        s.acc_offset,
+        s.acc_temp_coef,
+        dtemp,
+        s.acc_noise_density * half_bw,
+        s.acc_bias_walk * sq_dt,
+        rng,
+        s.acc_range,
+        s.quantize,
+    )
+    gyr_m, gyr_b, gyr_sat = _measure(
+        gyr,
+        s.gyr_scale,
+        s.gyr_misalign,
+        s.gyr_offset,
+        s.gyr_temp_coef,
+        dtemp,
+        s.gyr_noise_density * half_bw,
+        s.gyr_bias_walk * sq_dt,
+        rng,
+        s.gyr_range,
+        s.quantize,
+    )
     out = {"acc": acc_m, "gyr": gyr_m, "temp": temp, "sensor": s}
     truth = {
         "true_acc_offset": np.asarray(s.acc_offset, float).tolist(),
         "true_gyr_offset": np.asarray(s.gyr_offset, float).tolist(),
-        "true_acc_offset_mean": (np.asarray(s.acc_offset) + np.mean(dtemp) * np.asarray(s.acc_temp_coef) + acc_b).tolist(),
-        "true_gyr_offset_mean": (np.asarray(s.gyr_offset) + np.mean(dtemp) * np.asarray(s.gyr_temp_coef) + gyr_b).tolist(),
-        "true_acc_matrix": ((np.eye(3) + np.diag(s.acc_scale)) @ (np.eye(3) + np.asarray(s.acc_misalign))).tolist(),
-        "true_gyr_matrix": ((np.eye(3) + np.diag(s.gyr_scale)) @ (np.eye(3) + np.asarray(s.gyr_misalign))).tolist(),
+        "true_acc_offset_mean": (
+            np.asarray(s.acc_offset)
+            + np.mean(dtemp) * np.asarray(s.acc_temp_coef)
+            + acc_b
+        ).tolist(),
+        "true_gyr_offset_mean": (
+            np.asarray(s.gyr_offset)
+            + np.mean(dtemp) * np.asarray(s.gyr_temp_coef)
+            + gyr_b
+        ).tolist(),
+        "true_acc_matrix": (
+            (np.eye(3) + np.diag(s.acc_scale))
+            @ (np.eye(3) + np.asarray(s.acc_misalign))
+        ).tolist(),
+        "true_gyr_matrix": (
+            (np.eye(3) + np.diag(s.gyr_scale))
+            @ (np.eye(3) + np.asarray(s.gyr_misalign))
+        ).tolist(),
         "true_acc_temp_coef": np.asarray(s.acc_temp_coef, float).tolist(),
         "true_gyr_temp_coef": np.asarray(s.gyr_temp_coef, float).tolist(),
         "true_temp_ref": s.temp_ref,
@@ -322,13 +456,20 @@ def apply_sensor_model(true: dict, sensor: SensorModel | None, rng: np.random.Ge
         if "q" not in true:
             raise ValueError("a magnetometer needs the true orientation 'q'")
         out["mag"], m_w = magnetometer_readings(true["q"], s, rng)
-        truth.update({"true_mag_hard_iron": np.asarray(s.mag_hard_iron, float).tolist(), "true_mag_soft_iron": np.asarray(s.mag_soft_iron).tolist(),
-                      "true_field_world_uT": m_w.tolist()})
+        truth.update(
+            {
+                "true_mag_hard_iron": np.asarray(s.mag_hard_iron, float).tolist(),
+                "true_mag_soft_iron": np.asarray(s.mag_soft_iron).tolist(),
+                "true_field_world_uT": m_w.tolist(),
+            }
+        )
     out["truth"] = truth
     return out
 
 
-def magnetometer_readings(q, sensor: SensorModel, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
+def magnetometer_readings(
+    q, sensor: SensorModel, rng: np.random.Generator
+) -> tuple[np.ndarray, np.ndarray]:
     r"""Magnetometer output (µT) of a drawn sensor (:func:`draw_sensor`) at orientations ``q``.
 
     The local field in ENU is :math:`m_w = B\,(0, \cos I, -\sin I)` (strength ``field_uT``,
@@ -346,7 +487,9 @@ def magnetometer_readings(q, sensor: SensorModel, rng: np.random.Generator) -> t
     q = np.asarray(q, float)
     dip = math.radians(sensor.dip_deg)
     m_w = sensor.field_uT * np.array([0.0, math.cos(dip), -math.sin(dip)])
-    mag = _quat.rotate_inverse(q, m_w) @ np.asarray(sensor.mag_soft_iron, float).T + np.asarray(sensor.mag_hard_iron, float)
+    mag = _quat.rotate_inverse(q, m_w) @ np.asarray(
+        sensor.mag_soft_iron, float
+    ).T + np.asarray(sensor.mag_hard_iron, float)
     if sensor.mag_noise_uT > 0:
         mag += sensor.mag_noise_uT * rng.standard_normal(mag.shape)
     if sensor.quantize:
@@ -360,8 +503,14 @@ def true_sensor_values(q, a_lin_g) -> np.ndarray:
     return _quat.rotate_inverse(q, a + np.array([0.0, 0.0, 1.0]))
 
 
-def recording_from_motion(motion: TrueMotion, *, rng: np.random.Generator, sensor: SensorModel | None = None,
-                          keep_true: bool = True, attrs: dict | None = None) -> xr.Dataset:
+def recording_from_motion(
+    motion: TrueMotion,
+    *,
+    rng: np.random.Generator,
+    sensor: SensorModel | None = None,
+    keep_true: bool = True,
+    attrs: dict | None = None,
+) -> xr.Dataset:
     """Turn a :class:`TrueMotion` into a validated Recording through a sensor model.
 
     Variables: measured ``acc`` (g), ``gyr`` (°/s), ``temp`` (°C), optional ``mag`` (µT);
@@ -373,17 +522,45 @@ def recording_from_motion(motion: TrueMotion, *, rng: np.random.Generator, senso
     a_lin_g = motion.a_lin / G0
     acc_true = true_sensor_values(motion.q, a_lin_g)
     gyr_true = np.degrees(motion.omega)
-    meas = apply_sensor_model({"acc": acc_true, "gyr": gyr_true, "q": motion.q}, sensor, rng, fs)
+    meas = apply_sensor_model(
+        {"acc": acc_true, "gyr": gyr_true, "q": motion.q}, sensor, rng, fs
+    )
     extra = {
-        "state": (("time",), motion.state.astype(np.int8),
-                  {"long_name": "behavioural state (ground truth)", "flag_values": list(range(len(STATES))),
-                   "flag_meanings": " ".join(STATES)}),
-        "a_lin": (("time", "axis"), a_lin_g, {"units": "g", "frame": "world", "long_name": "true linear acceleration of the sensor"}),
+        "state": (
+            ("time",),
+            motion.state.astype(np.int8),
+            {
+                "long_name": "behavioural state (ground truth)",
+                "flag_values": list(range(len(STATES))),
+                "flag_meanings": " ".join(STATES),
+            },
+        ),
+        "a_lin": (
+            ("time", "axis"),
+            a_lin_g,
+            {
+                "units": "g",
+                "frame": "world",
+                "long_name": "true linear acceleration of the sensor",
+            },
+        ),
     }
     if keep_true:
-        extra["acc_true"] = (("time", "axis"), acc_true, {"units": "g", "frame": "sensor", "long_name": "true specific force"})
-        extra["gyr_true"] = (("time", "axis"), gyr_true, {"units": "deg/s", "frame": "sensor", "long_name": "true angular velocity"})
-        extra["pos"] = (("time", "axis"), motion.pos, {"units": "m", "frame": "world", "long_name": "true sensor position"})
+        extra["acc_true"] = (
+            ("time", "axis"),
+            acc_true,
+            {"units": "g", "frame": "sensor", "long_name": "true specific force"},
+        )
+        extra["gyr_true"] = (
+            ("time", "axis"),
+            gyr_true,
+            {"units": "deg/s", "frame": "sensor", "long_name": "true angular velocity"},
+        )
+        extra["pos"] = (
+            ("time", "axis"),
+            motion.pos,
+            {"units": "m", "frame": "world", "long_name": "true sensor position"},
+        )
     a = {
         "source": "tiltlab.simulate",
         "sensor": "simulated MPU-9250-like IMU",
@@ -396,8 +573,18 @@ def recording_from_motion(motion: TrueMotion, *, rng: np.random.Generator, senso
         **meas["truth"],
         **dict(attrs or {}),
     }
-    return _schema.make_recording(meas["acc"], meas["gyr"], fs, acc_units="g", gyr_units="deg/s", mag=meas.get("mag"),
-                                  temp=meas["temp"], q_ref=motion.q, extra=extra, attrs=a)
+    return _schema.make_recording(
+        meas["acc"],
+        meas["gyr"],
+        fs,
+        acc_units="g",
+        gyr_units="deg/s",
+        mag=meas.get("mag"),
+        temp=meas["temp"],
+        q_ref=motion.q,
+        extra=extra,
+        attrs=a,
+    )
 
 
 def simulate_session(
@@ -435,5 +622,9 @@ def simulate_session(
         A validated Recording (see :func:`recording_from_motion`).
     """
     rng = np.random.default_rng(seed)
-    motion = head_kinematics(duration_s, fs, behaviour=behaviour, lesion=lesion, rng=rng)
-    return recording_from_motion(motion, rng=rng, sensor=sensor, keep_true=keep_true, attrs=attrs)
+    motion = head_kinematics(
+        duration_s, fs, behaviour=behaviour, lesion=lesion, rng=rng
+    )
+    return recording_from_motion(
+        motion, rng=rng, sensor=sensor, keep_true=keep_true, attrs=attrs
+    )

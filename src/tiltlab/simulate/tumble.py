@@ -36,7 +36,6 @@ from .. import schema as _schema
 __all__ = ["stage_angles", "stage_quaternion", "tumble_test", "zoh_angular_velocity"]
 
 
-
 def zoh_angular_velocity(q, fs: float) -> np.ndarray:
     r"""Angular velocity (rad/s, sensor frame) whose zero-order-hold integral is ``q``:
     :math:`\omega_k = f_s\,\mathrm{Log}(q_k^* \otimes q_{k+1})`, last sample 0."""
@@ -116,7 +115,12 @@ def tumble_test(
         gamma = gamma + np.radians(err) * rng.standard_normal(gamma.shape)
     n_hold = max(1, int(round(hold_s * fs)))
     n_move = max(1, int(round(move_s * fs)))
-    b_seq, g_seq, idx_seq, trig = [np.zeros(n_hold)], [np.zeros(n_hold)], [np.full(n_hold, -1)], []
+    b_seq, g_seq, idx_seq, trig = (
+        [np.zeros(n_hold)],
+        [np.zeros(n_hold)],
+        [np.full(n_hold, -1)],
+        [],
+    )
     pos = n_hold
     cur_b, cur_g = 0.0, 0.0
     for i, (b, g) in enumerate(list(zip(beta, gamma)) + [(0.0, 0.0)]):
@@ -138,12 +142,28 @@ def tumble_test(
     trigger = np.zeros(n, bool)
     trigger[trig] = True
     acc_true = true_sensor_values(q, np.zeros((n, 3)))
-    meas = apply_sensor_model({"acc": acc_true, "gyr": np.degrees(omega), "q": q}, sensor, rng, fs)
+    meas = apply_sensor_model(
+        {"acc": acc_true, "gyr": np.degrees(omega), "q": q}, sensor, rng, fs
+    )
     extra = {
-        "trigger": (("time",), trigger, {"long_name": "digital trigger at each rotation onset"}),
-        "orientation": (("time",), np.concatenate(idx_seq).astype(np.int16), {"long_name": "index of the orientation held (-1: start position or moving)"}),
+        "trigger": (
+            ("time",),
+            trigger,
+            {"long_name": "digital trigger at each rotation onset"},
+        ),
+        "orientation": (
+            ("time",),
+            np.concatenate(idx_seq).astype(np.int16),
+            {
+                "long_name": "index of the orientation held (-1: start position or moving)"
+            },
+        ),
         "acc_true": (("time", "axis"), acc_true, {"units": "g", "frame": "sensor"}),
-        "gyr_true": (("time", "axis"), np.degrees(omega), {"units": "deg/s", "frame": "sensor"}),
+        "gyr_true": (
+            ("time", "axis"),
+            np.degrees(omega),
+            {"units": "deg/s", "frame": "sensor"},
+        ),
     }
     attrs = {
         "source": "tiltlab.simulate.tumble_test",
@@ -159,5 +179,13 @@ def tumble_test(
         "sensor_model": meas["sensor"].to_dict(),
         **meas["truth"],
     }
-    return _schema.make_recording(meas["acc"], meas["gyr"], fs, mag=meas.get("mag"), temp=meas["temp"], q_ref=q,
-                                  extra=extra, attrs=attrs)
+    return _schema.make_recording(
+        meas["acc"],
+        meas["gyr"],
+        fs,
+        mag=meas.get("mag"),
+        temp=meas["temp"],
+        q_ref=q,
+        extra=extra,
+        attrs=attrs,
+    )

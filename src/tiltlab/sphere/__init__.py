@@ -15,8 +15,16 @@ Submodules
   (Benhamou 2023, App. C).
 
 Everything is re-exported here: ``from tiltlab import sphere; sphere.tilt_map(g)``.
-Map figures (3-D sphere, Lambert azimuthal equal-area with cartopy) are in
-:mod:`tiltlab.spheremaps`.
+
+Every function that takes a series of directions accepts a labelled (time, axis)
+DataArray — e.g. ``filters.gravity(filters.estimate(rec, method))``, whose ``fs`` and
+``time`` coordinate are used where durations are needed (``tilt_map``'s ``time``,
+``mkde``, ``residence*``, ``passage_times``) — a Recording with a ``gravity`` variable,
+or a plain (N, 3) array with ``fs=``/``times=``.
+
+Map figures (3-D sphere, Lambert azimuthal equal-area with cartopy, heat maps, KDE
+maps) are in :mod:`tiltlab.plot` (:mod:`tiltlab.plot.maps`; :mod:`tiltlab.spheremaps`
+re-exports the map primitives).
 """
 
 from .mesh import (
@@ -68,11 +76,48 @@ from .kde import (
 from .residence import Residence, passage_times, residence, residence_series
 
 __all__ = [
-    "EDGE_EPS", "SphereMesh", "as_unit_vectors", "fibonacci_lattice", "from_lonlat", "histogram", "locate",
-    "sphere_mesh", "spherical_triangle_area", "tilt_map", "to_lonlat", "triangulate", "visited", "visited_fraction",
-    "ConfidenceCone", "VMFFit", "a3", "a3_inverse", "angle", "mean_tilt_point", "rotate_to_pole", "rotation_to_pole",
-    "sagittal_angle", "vmf_bootstrap", "vmf_cap_area", "vmf_fit", "vmf_logpdf", "vmf_pdf", "vmf_sample",
-    "EqualAreaGrid", "SphericalKDE", "equal_area_grid", "grid_for", "isopleth_mask", "isopleths", "kde", "mkde",
-    "reference_bandwidth", "slerp", "stationarity_thirds",
-    "Residence", "passage_times", "residence", "residence_series",
+    "EDGE_EPS",
+    "SphereMesh",
+    "as_unit_vectors",
+    "fibonacci_lattice",
+    "from_lonlat",
+    "histogram",
+    "locate",
+    "sphere_mesh",
+    "spherical_triangle_area",
+    "tilt_map",
+    "to_lonlat",
+    "triangulate",
+    "visited",
+    "visited_fraction",
+    "ConfidenceCone",
+    "VMFFit",
+    "a3",
+    "a3_inverse",
+    "angle",
+    "mean_tilt_point",
+    "rotate_to_pole",
+    "rotation_to_pole",
+    "sagittal_angle",
+    "vmf_bootstrap",
+    "vmf_cap_area",
+    "vmf_fit",
+    "vmf_logpdf",
+    "vmf_pdf",
+    "vmf_sample",
+    "EqualAreaGrid",
+    "SphericalKDE",
+    "equal_area_grid",
+    "grid_for",
+    "isopleth_mask",
+    "isopleths",
+    "kde",
+    "mkde",
+    "reference_bandwidth",
+    "slerp",
+    "stationarity_thirds",
+    "Residence",
+    "passage_times",
+    "residence",
+    "residence_series",
 ]

@@ -50,6 +50,7 @@ import numpy as np
 import pandas as pd
 from numba import njit, prange
 
+from .. import _validate
 from .mesh import _series, as_unit_vectors, to_lonlat
 from .vmf import _frame, angle, vmf_fit
 
@@ -126,15 +127,16 @@ class EqualAreaGrid:
         return np.asarray(vectors, float) @ self.rotation
 
 
-def equal_area_grid(cell_deg: float = 1.0, *, pole=(0.0, 0.0, 1.0), meridian=None) -> EqualAreaGrid:
+def equal_area_grid(
+    cell_deg: float = 1.0, *, pole=(0.0, 0.0, 1.0), meridian=None
+) -> EqualAreaGrid:
     r"""Equal-area grid with :math:`\Delta\xi=\Delta s\approx` ``cell_deg`` (rad), pole along ``pole``.
 
     ``n_lon = round(360/cell_deg)`` and ``n_lat = round(2/Δξ)``; a 1° grid has
     360 × 115 = 41 400 cells of 3.04·10⁻⁴ sr. ``meridian`` (orthogonalised against
     ``pole``) sets grid longitude 0; default: the coordinate axis least aligned with the pole.
     """
-    if not np.isfinite(cell_deg) or not 0 < cell_deg <= 90:
-        raise ValueError(f"cell_deg must be in (0, 90], got {cell_deg!r}")
+    cell_deg = _check_cell_deg(cell_deg)
     n_lon = int(round(360.0 / cell_deg))
     n_lat = max(2, int(round(2.0 / (2 * np.pi / n_lon))))
     p = np.asarray(pole, float).reshape(3)
@@ -154,8 +156,20 @@ def equal_area_grid(cell_deg: float = 1.0, *, pole=(0.0, 0.0, 1.0), meridian=Non
     return EqualAreaGrid(n_lon, n_lat, R)
 
 
+def _check_cell_deg(cell_deg) -> float:
+    cell_deg = _validate.finite(cell_deg, "cell_deg")
+    if not 0 < cell_deg <= 90:
+        raise ValueError(f"cell_deg must be in (0, 90], got {cell_deg!r}")
+    return cell_deg
+
+
 def grid_for(vectors, cell_deg: float = 1.0, weights=None) -> EqualAreaGrid:
-    """Equal-area grid whose pole is 90° from the data's mean direction (data on the grid's equator)."""
+    """Equal-area grid whose pole is 90° from the data's mean direction (data on the grid's equator).
+
+    ``vectors``: a labelled (time, axis) series, a Recording (its ``gravity``) or an
+    (N, 3) array; NaN rows are ignored.
+    """
+    cell_deg = _check_cell_deg(cell_deg)
     x = as_unit_vectors(vectors, "vectors", allow_nan=True)
     ok = np.isfinite(x).all(axis=1)
     m = x[ok].sum(axis=0) if weights is None else np.asarray(weights, float)[ok] @ x[ok]
@@ -184,12 +198,15 @@ class SphericalKDE(NamedTuple):
 # ---------------------------------------------------------------------------
 
 
-def reference_bandwidth(vectors, weights=None, *, n: int | None = None, method: str = "mle") -> float:
+def reference_bandwidth(
+    vectors, weights=None, *, n: int | None = None, method: str = "mle"
+) -> float:
     r"""Reference smoothing parameter :math:`h_{ref}=\hat\kappa^{-1/2}\,n^{-1/6}` (Benhamou §7; Silverman's rule).
 
     Parameters
     ----------
-    vectors : (N, 3)
+    vectors : xarray.DataArray, xarray.Dataset or array_like, shape (N, 3)
+        A labelled (time, axis) series, a Recording (its ``gravity``) or an array.
     weights : (N,), optional
         Weights for the mean resultant length :math:`\bar R`.
     n : int, optional
@@ -199,10 +216,9 @@ def reference_bandwidth(vectors, weights=None, *, n: int | None = None, method: 
         (Benhamou's printed form; the two agree to :math:`O(e^{-2\kappa})` once κ ≳ 3,
         because :math:`A_3(\kappa) = \coth\kappa - 1/\kappa \approx 1-1/\kappa`).
     """
-    fit = vmf_fit(vectors, weights)
-    n = int(np.asarray(vectors).shape[0] if n is None else n)
-    if n < 1:
-        raise ValueError("n must be >= 1")
+    x = as_unit_vectors(vectors, "vectors")
+    fit = vmf_fit(x, weights)
+    n = x.shape[0] if n is None else _validate.integer(n, "n", minimum=1)
     if method == "mle":
         inv_k = 1.0 / fit.kappa if fit.kappa > 0 else np.inf
     elif method == "benhamou":
@@ -299,8 +315,7 @@ def _kde_scatter(lon, s, kap, w, n_lon, n_lat, log_tol, exact, out):
 def _scatter(x, w, h, grid: EqualAreaGrid, kernel: str, tol: float) -> np.ndarray:
     if kernel not in ("vmf", "gauss"):
         raise ValueError(f"kernel must be 'vmf' or 'gauss', got {kernel!r}")
-    if not 0 < tol < 1:
-        raise ValueError("tol must be in (0, 1)")
+    _validate.fraction(tol, "tol", open_low=True, open_high=True)
     h = np.broadcast_to(np.asarray(h, float), (x.shape[0],))
     if np.any(~np.isfinite(h)) or np.any(h <= 0):
         raise ValueError("bandwidth h must be finite and > 0")
@@ -309,21 +324,39 @@ def _scatter(x, w, h, grid: EqualAreaGrid, kernel: str, tol: float) -> np.ndarra
     s = np.clip(g[:, 2], -1.0, 1.0)
     nchunk = max(1, min(numba.get_num_threads(), x.shape[0]))
     out = np.zeros((nchunk, grid.n_lat, grid.n_lon))
-    _kde_scatter(np.ascontiguousarray(lon), np.ascontiguousarray(s), np.ascontiguousarray(1.0 / h**2),
-                 np.ascontiguousarray(w, dtype=float), grid.n_lon, grid.n_lat, float(np.log(tol)), kernel == "vmf", out)
+    _kde_scatter(
+        np.ascontiguousarray(lon),
+        np.ascontiguousarray(s),
+        np.ascontiguousarray(1.0 / h**2),
+        np.ascontiguousarray(w, dtype=float),
+        grid.n_lon,
+        grid.n_lat,
+        float(np.log(tol)),
+        kernel == "vmf",
+        out,
+    )
     return out.sum(axis=0) / w.sum()
 
 
-def kde(vectors, *, grid: EqualAreaGrid | None = None, h: float | None = None, weights=None,
-        kernel: str = "vmf", cell_deg: float = 1.0, tol: float = 1e-10) -> SphericalKDE:
+def kde(
+    vectors,
+    *,
+    grid: EqualAreaGrid | None = None,
+    h: float | None = None,
+    weights=None,
+    kernel: str = "vmf",
+    cell_deg: float = 1.0,
+    tol: float = 1e-10,
+) -> SphericalKDE:
     r"""Location-based spherical KDE (Benhamou Eq. 15 with vMF kernels) on an equal-area grid.
 
     .. math:: U_c = \frac{\sum_i w_i K_h(c;\mu_i)}{\sum_i w_i}
 
     Parameters
     ----------
-    vectors : array_like, shape (N, 3)
-        Locations on the sphere (normalised here; NaN rows dropped).
+    vectors : xarray.DataArray, xarray.Dataset or array_like, shape (N, 3)
+        Locations on the sphere (normalised here; NaN rows dropped): a labelled (time,
+        axis) series, a Recording (its ``gravity``) or an array.
     grid : EqualAreaGrid, optional
         Default :func:`grid_for` the data with ``cell_deg``.
     h : float, optional
@@ -340,6 +373,9 @@ def kde(vectors, *, grid: EqualAreaGrid | None = None, h: float | None = None, w
     """
     x = as_unit_vectors(vectors, "vectors", allow_nan=True)
     ok = np.isfinite(x).all(axis=1)
+    if h is not None:
+        h = _validate.positive(h, "h")
+    cell_deg = _check_cell_deg(cell_deg)
     w = np.ones(x.shape[0]) if weights is None else np.asarray(weights, float)
     if w.shape != (x.shape[0],) or np.any(~np.isfinite(w[ok])) or np.any(w[ok] < 0):
         raise ValueError("weights must be finite, >= 0 and of shape (N,)")
@@ -359,14 +395,29 @@ def slerp(a, b, t) -> np.ndarray:
     om = angle(a, b)[..., None]
     with np.errstate(invalid="ignore", divide="ignore"):
         so = np.sin(om)
-        p = np.where(so > 1e-12, (np.sin((1 - t) * om) * a + np.sin(t * om) * b) / np.where(so > 1e-12, so, 1.0),
-                     (1 - t) * a + t * b)
+        p = np.where(
+            so > 1e-12,
+            (np.sin((1 - t) * om) * a + np.sin(t * om) * b)
+            / np.where(so > 1e-12, so, 1.0),
+            (1 - t) * a + t * b,
+        )
     return p / np.linalg.norm(p, axis=-1, keepdims=True)
 
 
-def mkde(vectors, *, fs: float | None = None, times=None, grid: EqualAreaGrid | None = None,
-         h: float | None = None, step: float | None = None, diffusion: float = 0.0,
-         max_gap: float = np.inf, kernel: str = "vmf", cell_deg: float = 1.0, tol: float = 1e-10) -> SphericalKDE:
+def mkde(
+    vectors,
+    *,
+    fs: float | None = None,
+    times=None,
+    grid: EqualAreaGrid | None = None,
+    h: float | None = None,
+    step: float | None = None,
+    diffusion: float = 0.0,
+    max_gap: float = np.inf,
+    kernel: str = "vmf",
+    cell_deg: float = 1.0,
+    tol: float = 1e-10,
+) -> SphericalKDE:
     r"""Movement-based spherical KDE: kernels placed along the orthodromic arcs between successive samples.
 
     Each step :math:`x_k\to x_{k+1}` (duration :math:`\Delta t_k`, arc :math:`\omega_k`) is
@@ -379,22 +430,27 @@ def mkde(vectors, *, fs: float | None = None, times=None, grid: EqualAreaGrid | 
 
     Parameters
     ----------
-    vectors : (N, 3) time-ordered directions.
-    fs, times : sampling rate (Hz) or sample times (s); one is required.
+    vectors : xarray.DataArray, xarray.Dataset or array_like, shape (N, 3)
+        Time-ordered directions: a labelled (time, axis) series with ``attrs["fs"]`` (e.g.
+        :func:`tiltlab.filters.gravity`), a Recording with a ``gravity`` variable, or a
+        plain array.
+    fs, times : sampling rate (Hz) or sample times (s) of a plain array (one is
+        required). Labelled data use their ``time`` coordinate and ``fs``; an ``fs`` that
+        contradicts ``attrs["fs"]`` is an error, and so is labelled data without ``fs``.
     h : base bandwidth (rad), default :func:`reference_bandwidth` of the samples.
     step : maximal sub-arc length (rad), default h/2.
+    diffusion : Brownian-bridge diffusion coefficient (rad²/s), ≥ 0.
     max_gap : steps longer than this (s) are dropped (data gaps).
     """
-    x, t = _series(vectors, fs, times)
+    x, t, _ = _series(vectors, fs, times)
     n = x.shape[0]
     if n < 2:
         raise ValueError("need at least 2 samples")
-    if diffusion < 0:
-        raise ValueError("diffusion must be >= 0")
-    h = reference_bandwidth(x) if h is None else float(h)
-    step = h / 2 if step is None else float(step)
-    if step <= 0:
-        raise ValueError("step must be > 0")
+    diffusion = _validate.nonnegative(diffusion, "diffusion")
+    max_gap = _validate.positive(max_gap, "max_gap", allow_inf=True)
+    cell_deg = _check_cell_deg(cell_deg)
+    h = reference_bandwidth(x) if h is None else _validate.positive(h, "h")
+    step = h / 2 if step is None else _validate.positive(step, "step")
     dt = np.diff(t)
     keep = dt <= max_gap
     a, b, dt = x[:-1][keep], x[1:][keep], dt[keep]
@@ -419,7 +475,9 @@ def mkde(vectors, *, fs: float | None = None, times=None, grid: EqualAreaGrid | 
 
 def _dens_area(density, cell_area):
     if isinstance(density, SphericalKDE):
-        return density.density.ravel(), np.full(density.density.size, density.grid.cell_area)
+        return density.density.ravel(), np.full(
+            density.density.size, density.grid.cell_area
+        )
     d = np.asarray(density, float).ravel()
     a = np.broadcast_to(np.asarray(cell_area, float), np.asarray(density).shape).ravel()
     if d.size == 0 or np.any(~np.isfinite(d)) or np.any(d < 0) or np.any(a <= 0):
@@ -459,19 +517,27 @@ def isopleths(density, cell_area=None, levels=(0.5, 0.95)) -> pd.DataFrame:
     cum = np.cumsum(mass) / tot
     rows = []
     for lev in np.atleast_1d(levels):
-        if not 0 < lev < 1:
-            raise ValueError("levels must be in (0, 1)")
+        lev = _validate.fraction(lev, "levels", open_low=True, open_high=True)
         kk = int(min(np.searchsorted(cum, lev), d.size - 1))
         before = cum[kk - 1] if kk > 0 else 0.0
         part = (lev - before) / (mass[kk] / tot) if mass[kk] > 0 else 0.0
         area = a[order[:kk]].sum() + part * a[order[kk]]
-        rows.append((float(lev), float(d[order[kk]]), float(area), float(area / (4 * np.pi))))
-    return pd.DataFrame(rows, columns=["level", "threshold", "area", "sphere_fraction"]).set_index("level")
+        rows.append(
+            (float(lev), float(d[order[kk]]), float(area), float(area / (4 * np.pi)))
+        )
+    return pd.DataFrame(
+        rows, columns=["level", "threshold", "area", "sphere_fraction"]
+    ).set_index("level")
 
 
 def isopleth_mask(density, level: float, cell_area=None) -> np.ndarray:
     """Boolean mask (shape of the density) of the cells inside the ``level`` cumulative isopleth."""
-    arr = density.density if isinstance(density, SphericalKDE) else np.asarray(density, float)
+    level = _validate.fraction(level, "level", open_low=True, open_high=True)
+    arr = (
+        density.density
+        if isinstance(density, SphericalKDE)
+        else np.asarray(density, float)
+    )
     thr = isopleths(density, cell_area, [level])["threshold"].iloc[0]
     return arr >= thr
 
@@ -491,6 +557,9 @@ def stationarity_thirds(vectors, weights=None) -> pd.DataFrame:
     :math:`\delta=\sqrt{2(1-\bar R)}` (rad; ≈ κ^{-1/2}) and the angle between the third's
     mean and the overall mean (degrees). ``df.attrs`` holds the largest of those angles
     (``max_angle_deg``) and the largest/smallest κ̂ ratio (``kappa_ratio``).
+
+    ``vectors``: a labelled (time, axis) series, a Recording (its ``gravity``) or an
+    (N, 3) array, in time order.
     """
     x = as_unit_vectors(vectors, "vectors")
     n = x.shape[0]
@@ -498,19 +567,34 @@ def stationarity_thirds(vectors, weights=None) -> pd.DataFrame:
         raise ValueError("need at least 3 samples")
     w = np.ones(n) if weights is None else np.asarray(weights, float)
     edges = np.linspace(0, n, 4).round().astype(int)
-    parts = [("first", slice(edges[0], edges[1])), ("second", slice(edges[1], edges[2])),
-             ("third", slice(edges[2], edges[3])), ("all", slice(0, n))]
+    parts = [
+        ("first", slice(edges[0], edges[1])),
+        ("second", slice(edges[1], edges[2])),
+        ("third", slice(edges[2], edges[3])),
+        ("all", slice(0, n)),
+    ]
     overall = vmf_fit(x, w).mu
     rows = []
     for name, sl in parts:
         f = vmf_fit(x[sl], w[sl])
         lon, lat = to_lonlat(f.mu)
-        rows.append(dict(part=name, n=sl.stop - sl.start, mu_x=f.mu[0], mu_y=f.mu[1], mu_z=f.mu[2],
-                         lon_deg=np.degrees(lon), lat_deg=np.degrees(lat), rbar=f.rbar, kappa=f.kappa,
-                         dispersion=np.sqrt(2 * (1 - f.rbar)), angle_to_all_deg=np.degrees(angle(f.mu, overall))))
+        rows.append(
+            dict(
+                part=name,
+                n=sl.stop - sl.start,
+                mu_x=f.mu[0],
+                mu_y=f.mu[1],
+                mu_z=f.mu[2],
+                lon_deg=np.degrees(lon),
+                lat_deg=np.degrees(lat),
+                rbar=f.rbar,
+                kappa=f.kappa,
+                dispersion=np.sqrt(2 * (1 - f.rbar)),
+                angle_to_all_deg=np.degrees(angle(f.mu, overall)),
+            )
+        )
     df = pd.DataFrame(rows).set_index("part")
     thirds = df.iloc[:3]
     df.attrs["max_angle_deg"] = float(thirds["angle_to_all_deg"].max())
     df.attrs["kappa_ratio"] = float(thirds["kappa"].max() / thirds["kappa"].min())
     return df
-

@@ -37,11 +37,26 @@ References
    doi:10.1007/s11004-009-9257-x
 .. [4] O. Devillers, S. Pion, M. Teillaud, "Walking in a triangulation", Int. J. Found.
    Comput. Sci. 13(2):181–199, 2002. doi:10.1142/S0129054102001047
+
+Inputs
+------
+Every function of :mod:`tiltlab.sphere` that takes a series of directions accepts
+
+* a labelled :class:`xarray.DataArray` with dims ``(time, axis)`` — e.g. the output of
+  :func:`tiltlab.filters.gravity` — whose ``attrs["fs"]`` and ``time`` coordinate are used
+  where a function needs time;
+* a Recording (:class:`xarray.Dataset`): its ``gravity`` variable (compute it with
+  ``rec["gravity"] = filters.gravity(filters.estimate(rec, method))``) and its ``fs``;
+* a plain array of shape (N, 3), with ``fs=`` (or ``times=``) given where time is needed.
+
+Reading goes through :func:`tiltlab._validate.signal`: an ``fs`` argument that
+contradicts the data's attribute, or a time coordinate that contradicts ``fs``, is an
+error; so is a missing ``fs`` where a function needs durations.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import lru_cache
 
 import numpy as np
@@ -49,6 +64,8 @@ import xarray as xr
 from numba import njit, prange
 from scipy.spatial import ConvexHull
 
+from .. import _validate
+from .._validate import RecordingError
 from ..frames import fibonacci_lattice
 
 __all__ = [
@@ -78,23 +95,115 @@ EDGE_EPS = 1e-12
 
 
 def as_unit_vectors(v, name: str = "vectors", allow_nan: bool = False) -> np.ndarray:
-    """Validate an (N, 3) array of directions and return unit vectors (a new array).
+    """Validate directions and return them as unit vectors, shape (N, 3) (a new array).
 
+    ``v`` is a labelled (time, axis) DataArray, a Recording (its ``gravity`` variable), an
+    (N, 3) array or a single (3,) vector; it is read with :func:`tiltlab._validate.signal`.
     Rows must be finite and non-zero; with ``allow_nan`` NaN rows stay NaN.
     """
-    a = np.asarray(v, dtype=float)
-    if a.ndim == 1 and a.shape == (3,):
-        a = a[None, :]
-    if a.ndim != 2 or a.shape[1] != 3:
-        raise ValueError(f"{name} must have shape (N, 3), got {np.shape(v)}")
-    bad = ~np.isfinite(a).all(axis=1)
-    if bad.any() and not allow_nan:
-        raise ValueError(f"{name} contains {int(bad.sum())} non-finite rows")
+    a = _read(v, name=name, allow_nan=allow_nan).values
+    bad = np.isnan(a).any(axis=1)
     n = np.linalg.norm(a, axis=1)
     if np.any((n == 0) & ~bad):
         raise ValueError(f"{name} contains zero vectors (no direction)")
     with np.errstate(invalid="ignore"):
         return a / n[:, None]
+
+
+_NO_GRAVITY = (
+    "the Recording has no 'gravity' variable; compute the tilt first, e.g. "
+    "rec['gravity'] = filters.gravity(filters.estimate(rec, method)), or pass that DataArray"
+)
+
+
+def _read(
+    vectors,
+    *,
+    name: str = "vectors",
+    fs=None,
+    need_fs: bool = False,
+    check_time: bool | None = None,
+    allow_nan: bool = False,
+) -> _validate.Signal:
+    """Read one direction series (Recording, labelled DataArray or array) via ``_validate.signal``.
+
+    A Recording must hold a ``gravity`` variable; its ``fs`` is the dataset's (or, when the
+    dataset has none, the variable's). A DataArray is put in (time, axis) order; a plain
+    (3,) vector counts as one sample.
+
+    ``check_time`` (default ``need_fs``): let ``signal`` check ``fs`` against the time
+    coordinate (median step). Functions that use neither time nor ``fs`` skip it, so a
+    decimated series (``g[::4]``, whose ``fs`` attribute is stale) can still be fitted or
+    smoothed; a series subset by a mask (``g[immobile]``) passes it as long as its
+    median step stays ``1 / fs``.
+    """
+    if check_time is None:
+        check_time = need_fs
+    data = vectors
+    if isinstance(data, xr.Dataset):
+        if "gravity" not in data:
+            raise RecordingError(f"{name}: {_NO_GRAVITY}")
+        if "fs" not in data.attrs and "fs" in data["gravity"].attrs:
+            data = data["gravity"]
+    time = None
+    if isinstance(data, (xr.DataArray, xr.Dataset)):
+        da = data["gravity"] if isinstance(data, xr.Dataset) else data
+        if "time" in da.coords and da["time"].ndim == 1:
+            time = np.asarray(da["time"].values, dtype=float)
+            if not check_time:
+                data = data.drop_vars("time")
+    if isinstance(data, xr.DataArray):
+        if "axis" in data.dims and data.dims[-1] != "axis":
+            data = data.transpose(..., "axis")
+    elif not isinstance(data, xr.Dataset):
+        a = np.asarray(data)
+        if a.shape == (3,):
+            data = a[None, :]
+    sig = _validate.signal(
+        data, name, var="gravity", fs=fs, need_fs=need_fs, allow_nan=allow_nan
+    )
+    return sig if sig.time is not None or time is None else replace(sig, time=time)
+
+
+def _series(vectors, fs, times, name: str = "vectors"):
+    """Unit vectors (N, 3), their times (s) and the Signal read from ``vectors``.
+
+    Times come from ``times`` (strictly increasing, shape (N,)), else from the data's
+    ``time`` coordinate, else from ``fs`` (``t = i / fs``). Without ``times`` the sampling
+    rate is required (argument or attribute); a ``times`` that contradicts the data's
+    time coordinate is an error.
+    """
+    if (
+        fs is None
+        and times is None
+        and not isinstance(vectors, (xr.DataArray, xr.Dataset))
+    ):
+        raise RecordingError(
+            f"{name}: the sampling rate fs is unknown (pass fs= or times=); "
+            "tiltlab never assumes a default"
+        )
+    sig = _read(vectors, name=name, fs=fs, need_fs=times is None)
+    x = as_unit_vectors(sig.values, name)
+    n = x.shape[0]
+    if times is not None:
+        t = np.asarray(times, float)
+        if t.shape != (n,) or not np.all(np.isfinite(t)) or np.any(np.diff(t) <= 0):
+            raise ValueError(
+                f"times must be finite and strictly increasing with shape ({n},)"
+            )
+        if sig.time is not None and not np.allclose(t, sig.time, rtol=0.0, atol=1e-9):
+            raise RecordingError(
+                f"{name}: times= contradicts the data's time coordinate"
+            )
+    elif sig.time is not None:
+        t = np.asarray(sig.time, float)
+        if t.shape != (n,) or not np.all(np.isfinite(t)) or np.any(np.diff(t) <= 0):
+            raise RecordingError(
+                f"{name}: the time coordinate is not strictly increasing"
+            )
+    else:
+        t = np.arange(n) / sig.fs
+    return x, t, sig
 
 
 def to_lonlat(v) -> tuple[np.ndarray, np.ndarray]:
@@ -106,7 +215,9 @@ def to_lonlat(v) -> tuple[np.ndarray, np.ndarray]:
     v = np.asarray(v, float)
     if v.shape[-1] != 3:
         raise ValueError(f"vectors must have a last axis of length 3, got {v.shape}")
-    return np.arctan2(v[..., 1], v[..., 0]), np.arctan2(v[..., 2], np.hypot(v[..., 0], v[..., 1]))
+    return np.arctan2(v[..., 1], v[..., 0]), np.arctan2(
+        v[..., 2], np.hypot(v[..., 0], v[..., 1])
+    )
 
 
 def from_lonlat(lon, lat) -> np.ndarray:
@@ -135,7 +246,12 @@ def spherical_triangle_area(a, b, c) -> np.ndarray:
             raise ValueError(f"{name} must have a last axis of length 3, got {x.shape}")
     a, b, c = (x / np.linalg.norm(x, axis=-1, keepdims=True) for x in (a, b, c))
     num = np.abs(np.einsum("...i,...i->...", a, np.cross(b, c)))
-    den = 1.0 + np.einsum("...i,...i->...", a, b) + np.einsum("...i,...i->...", b, c) + np.einsum("...i,...i->...", c, a)
+    den = (
+        1.0
+        + np.einsum("...i,...i->...", a, b)
+        + np.einsum("...i,...i->...", b, c)
+        + np.einsum("...i,...i->...", c, a)
+    )
     return 2.0 * np.arctan2(num, den)
 
 
@@ -210,7 +326,9 @@ def triangulate(vertices, *, lut_m: int | None = None) -> SphereMesh:
     faces[flip, 1], faces[flip, 2] = faces[flip, 2].copy(), faces[flip, 1].copy()
     nbr[flip, 1], nbr[flip, 2] = nbr[flip, 2].copy(), nbr[flip, 1].copy()
     a, b, c = v[faces[:, 0]], v[faces[:, 1]], v[faces[:, 2]]
-    if np.any(np.einsum("ij,ij->i", hull.equations[:, :3], a) <= 0):  # pragma: no cover - hull sanity
+    if np.any(
+        np.einsum("ij,ij->i", hull.equations[:, :3], a) <= 0
+    ):  # pragma: no cover - hull sanity
         raise ValueError("the convex hull does not contain the origin")
     areas = spherical_triangle_area(a, b, c)
     cen = a + b + c
@@ -224,8 +342,17 @@ def triangulate(vertices, *, lut_m: int | None = None) -> SphereMesh:
     np.cumsum(np.bincount(faces.ravel(), minlength=v.shape[0]), out=vf_ptr[1:])
     m = int(lut_m) if lut_m is not None else max(4, int(np.ceil(np.sqrt(nf / 6.0))))
     lut = _build_lut(m, en, nbr, faces, vf_ptr, vf_idx)
-    arrays = dict(vertices=v, faces=faces, neighbors=nbr, areas=areas, centroids=cen, edge_normals=en,
-                  vf_ptr=vf_ptr, vf_idx=vf_idx, lut=lut)
+    arrays = dict(
+        vertices=v,
+        faces=faces,
+        neighbors=nbr,
+        areas=areas,
+        centroids=cen,
+        edge_normals=en,
+        vf_ptr=vf_ptr,
+        vf_idx=vf_idx,
+        lut=lut,
+    )
     for x in arrays.values():
         x.flags.writeable = False
     return SphereMesh(**arrays, lut_m=m)
@@ -338,34 +465,58 @@ def _locate_kernel(x, en, nbr, faces, vf_ptr, vf_idx, lut, m, eps, out):
             out[i] = -1
             continue
         p0, p1, p2 = p0 / r, p1 / r, p2 / r
-        out[i] = _walk(en, nbr, faces, vf_ptr, vf_idx, lut[_cube_cell(p0, p1, p2, m)], p0, p1, p2, eps)
+        out[i] = _walk(
+            en,
+            nbr,
+            faces,
+            vf_ptr,
+            vf_idx,
+            lut[_cube_cell(p0, p1, p2, m)],
+            p0,
+            p1,
+            p2,
+            eps,
+        )
 
 
-def locate(vectors, mesh: SphereMesh | None = None) -> np.ndarray:
+def _locate(x: np.ndarray, mesh: SphereMesh) -> np.ndarray:
+    x = np.ascontiguousarray(x, dtype=float)
+    out = np.empty(x.shape[0], np.int64)
+    _locate_kernel(
+        x,
+        mesh.edge_normals,
+        mesh.neighbors,
+        mesh.faces,
+        mesh.vf_ptr,
+        mesh.vf_idx,
+        mesh.lut,
+        mesh.lut_m,
+        EDGE_EPS,
+        out,
+    )
+    return out
+
+
+def locate(vectors, mesh: SphereMesh | None = None):
     """Index of the facet containing each direction (vectorised numba walk).
 
     Parameters
     ----------
-    vectors : array_like, shape (N, 3)
-        Directions (any non-zero norm). Rows that are not finite or are zero give -1.
+    vectors : xarray.DataArray, xarray.Dataset or array_like, shape (N, 3)
+        Directions (any non-zero norm): a labelled (time, axis) series, a Recording (its
+        ``gravity``) or a plain array. NaN or zero rows give -1; ±inf is an error.
     mesh : SphereMesh, optional
         Default :func:`sphere_mesh` (5000 vertices).
 
     Returns
     -------
-    numpy.ndarray of int64, shape (N,)
+    numpy.ndarray of int64, shape (N,), or xarray.DataArray ``facet`` (dim ``time``) for labelled input
         Facet index; a vector on a shared edge or vertex goes to the lowest-index facet
         containing it (closed facets, tolerance ``EDGE_EPS``), so each sample is counted once.
     """
     mesh = sphere_mesh() if mesh is None else mesh
-    x = np.asarray(vectors, dtype=float)
-    if x.ndim != 2 or x.shape[1] != 3:
-        raise ValueError(f"vectors must have shape (N, 3), got {x.shape}")
-    x = np.ascontiguousarray(x)
-    out = np.empty(x.shape[0], np.int64)
-    _locate_kernel(x, mesh.edge_normals, mesh.neighbors, mesh.faces, mesh.vf_ptr, mesh.vf_idx, mesh.lut,
-                   mesh.lut_m, EDGE_EPS, out)
-    return out
+    sig = _read(vectors, allow_nan=True)
+    return _validate.labelled(_locate(sig.values, mesh), sig, "facet", dims=("time",))
 
 
 # ---------------------------------------------------------------------------
@@ -373,13 +524,7 @@ def locate(vectors, mesh: SphereMesh | None = None) -> np.ndarray:
 # ---------------------------------------------------------------------------
 
 
-def histogram(vectors, mesh: SphereMesh | None = None, *, weights=None) -> np.ndarray:
-    """Number of samples (or summed ``weights``) per facet, shape (F,).
-
-    Rows that are NaN (e.g. masked samples) are ignored.
-    """
-    mesh = sphere_mesh() if mesh is None else mesh
-    idx = locate(vectors, mesh)
+def _bincount(idx: np.ndarray, mesh: SphereMesh, weights) -> np.ndarray:
     ok = idx >= 0
     if weights is None:
         return np.bincount(idx[ok], minlength=mesh.n_faces)
@@ -389,54 +534,88 @@ def histogram(vectors, mesh: SphereMesh | None = None, *, weights=None) -> np.nd
     return np.bincount(idx[ok], weights=w[ok], minlength=mesh.n_faces)
 
 
-def tilt_map(vectors, *, mesh: SphereMesh | None = None, fs: float | None = None, mask=None) -> xr.Dataset:
+def histogram(vectors, mesh: SphereMesh | None = None, *, weights=None) -> np.ndarray:
+    """Number of samples (or summed ``weights``) per facet, shape (F,).
+
+    ``vectors`` is a labelled (time, axis) series, a Recording (its ``gravity``) or an
+    (N, 3) array. Rows that are NaN (e.g. masked samples) are ignored.
+    """
+    mesh = sphere_mesh() if mesh is None else mesh
+    sig = _read(vectors, allow_nan=True)
+    return _bincount(_locate(sig.values, mesh), mesh, weights)
+
+
+def tilt_map(
+    vectors, *, mesh: SphereMesh | None = None, fs: float | None = None, mask=None
+) -> xr.Dataset:
     r"""Head-tilt map: counts, time, time fraction and area-normalised density per facet.
 
     Parameters
     ----------
-    vectors : array_like, shape (N, 3)
-        Unit-vector series (tilt :math:`g_s`, heading, posture...). NaN rows are skipped.
+    vectors : xarray.DataArray, xarray.Dataset or array_like, shape (N, 3)
+        Unit-vector series (tilt :math:`g_s`, heading, posture...): a labelled (time, axis)
+        DataArray such as :func:`tiltlab.filters.gravity`'s, a Recording with a
+        ``gravity`` variable, or a plain array. NaN rows are skipped.
     mesh : SphereMesh, optional
         Default: the cached 5000-vertex Fibonacci triangulation.
     fs : float, optional
-        Sampling rate (Hz); when given, ``time`` (s) per facet is added.
+        Sampling rate (Hz) of a plain array; labelled data carry their own (an ``fs``
+        that contradicts it, or the time coordinate, is an error; a masked subset such
+        as ``g[immobile]`` is fine). When the rate is known, ``time`` (s) per facet is
+        added.
     mask : array_like of bool, shape (N,), optional
-        Keep only these samples (e.g. immobility).
+        Keep only these samples (e.g. immobility; a boolean DataArray works too).
 
     Returns
     -------
     xarray.Dataset
         dims ``facet`` (and ``axis`` for ``centroid``): ``count``, ``fraction`` (of the
         kept samples), ``density`` = fraction / area (sr⁻¹; integrates to 1), ``time``
-        (s, if ``fs``), coords ``area`` (sr) and ``centroid``.
+        (s, if the sampling rate is known), coords ``area`` (sr) and ``centroid``.
     """
     mesh = sphere_mesh() if mesh is None else mesh
-    x = np.asarray(vectors, float)
+    sig = _read(vectors, fs=fs, need_fs=False, check_time=True, allow_nan=True)
+    x = sig.values
     if mask is not None:
-        mask = np.asarray(mask, bool)
+        mask = np.asarray(mask)
+        if mask.dtype != bool:
+            if not (
+                np.issubdtype(mask.dtype, np.number) and np.isin(mask, (0, 1)).all()
+            ):
+                raise ValueError(
+                    f"mask must be boolean (or 0/1), got dtype {mask.dtype}"
+                )
+            mask = mask.astype(bool)
         if mask.shape != x.shape[:1]:
             raise ValueError(f"mask must have shape {x.shape[:1]}, got {mask.shape}")
         x = x[mask]
-    counts = histogram(x, mesh)
+    counts = _bincount(_locate(x, mesh), mesh, None)
     total = counts.sum()
     if total == 0:
         raise ValueError("no valid samples to map")
     frac = counts / total
     ds = xr.Dataset(
         {
-            "count": ("facet", counts, {"units": "1"}),
-            "fraction": ("facet", frac, {"units": "1"}),
-            "density": ("facet", frac / mesh.areas, {"units": "1/sr"}),
+            "count": ("facet", counts, {"units": "1", "long_name": "samples"}),
+            "fraction": ("facet", frac, {"units": "1", "long_name": "time fraction"}),
+            "density": (
+                "facet",
+                frac / mesh.areas,
+                {"units": "1/sr", "long_name": "density"},
+            ),
         },
-        coords={"area": ("facet", np.array(mesh.areas), {"units": "sr"}),
-                "centroid": (("facet", "axis"), np.array(mesh.centroids)), "axis": ["x", "y", "z"]},
+        coords={
+            "area": ("facet", np.array(mesh.areas), {"units": "sr"}),
+            "centroid": (("facet", "axis"), np.array(mesh.centroids)),
+            "axis": ["x", "y", "z"],
+        },
         attrs={"n_samples": int(total), "n_vertices": mesh.n_vertices},
     )
-    if fs is not None:
-        if not np.isfinite(fs) or fs <= 0:
-            raise ValueError(f"fs must be a positive number, got {fs!r}")
-        ds["time"] = ("facet", counts / float(fs), {"units": "s"})
-        ds.attrs["fs"] = float(fs)
+    if sig.fs is not None:
+        ds["time"] = ("facet", counts / sig.fs, {"units": "s", "long_name": "time"})
+        ds.attrs["fs"] = sig.fs
+    if "method" in sig.attrs:
+        ds.attrs["method"] = sig.attrs["method"]
     return ds
 
 
@@ -448,10 +627,13 @@ def _counts(m) -> np.ndarray:
 
 def visited(tmap, *, min_count: int = 1) -> np.ndarray:
     """Binarised map: True for facets with at least ``min_count`` samples (Fayat Fig. 3c–d)."""
+    min_count = _validate.integer(min_count, "min_count", minimum=1)
     return _counts(tmap) >= min_count
 
 
-def visited_fraction(tmap, mesh: SphereMesh | None = None, *, min_count: int = 1, by: str = "area") -> float:
+def visited_fraction(
+    tmap, mesh: SphereMesh | None = None, *, min_count: int = 1, by: str = "area"
+) -> float:
     r"""Fraction of the sphere visited (facets with ≥ ``min_count`` samples).
 
     ``by="area"`` sums the exact facet areas over :math:`4\pi`; ``by="count"`` is the
@@ -467,18 +649,3 @@ def visited_fraction(tmap, mesh: SphereMesh | None = None, *, min_count: int = 1
     if by == "count":
         return float(v.mean())
     raise ValueError(f"by must be 'area' or 'count', got {by!r}")
-
-
-def _series(vectors, fs, times):
-    """Unit vectors (N, 3) and their times (s) from ``fs`` (Hz) or explicit strictly increasing ``times``."""
-    x = as_unit_vectors(vectors, "vectors")
-    n = x.shape[0]
-    if times is None:
-        if fs is None or not np.isfinite(fs) or fs <= 0:
-            raise ValueError("give fs (Hz) or times (s)")
-        t = np.arange(n) / float(fs)
-    else:
-        t = np.asarray(times, float)
-        if t.shape != (n,) or np.any(np.diff(t) <= 0):
-            raise ValueError("times must be strictly increasing with shape (N,)")
-    return x, t

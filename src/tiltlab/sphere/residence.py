@@ -41,6 +41,7 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit, prange
 
+from .. import _validate
 from .mesh import _series, as_unit_vectors
 
 __all__ = ["Residence", "passage_times", "residence", "residence_series"]
@@ -113,7 +114,9 @@ def _residence_kernel(x, t, centres, cos_r, t_out, tref, total, nvis, rt):
                     clus_start = tc
                 enter = tc
             else:  # exit between k-1 (in) and k (out), or end of the series
-                tc = t[n - 1] if k == n else _crossing(x, t, k - 1, k, c0, c1, c2, cos_r)
+                tc = (
+                    t[n - 1] if k == n else _crossing(x, t, k - 1, k, c0, c1, c2, cos_r)
+                )
                 tot += tc - enter
                 clus += tc - enter
                 last_exit = tc
@@ -125,35 +128,54 @@ def _residence_kernel(x, t, centres, cos_r, t_out, tref, total, nvis, rt):
         rt[m] = res
 
 
-def _check(radius, t_out):
+def _check(radius, t_out) -> tuple[float, float]:
+    radius = _validate.finite(radius, "radius")
     if not 0 < radius < np.pi / 2:
         raise ValueError(f"radius must be in (0, π/2) rad, got {radius!r}")
-    if not t_out >= 0:
-        raise ValueError("t_out must be >= 0")
+    t_out = _validate.positive(t_out, "t_out", allow_zero=True, allow_inf=True)
+    return radius, t_out
 
 
-def residence(vectors, centres, radius: float, t_out: float, *, fs: float | None = None, times=None,
-              ref_times=None) -> Residence:
+def residence(
+    vectors,
+    centres,
+    radius: float,
+    t_out: float,
+    *,
+    fs: float | None = None,
+    times=None,
+    ref_times=None,
+) -> Residence:
     """Time inside, number of visits and mean residence time per visit for caps around ``centres``.
 
     Parameters
     ----------
-    vectors : (N, 3) time-ordered directions.
+    vectors : xarray.DataArray, xarray.Dataset or array_like, shape (N, 3)
+        Time-ordered directions: a labelled (time, axis) series with ``attrs["fs"]``
+        (e.g. :func:`tiltlab.filters.gravity`), a Recording with a ``gravity`` variable,
+        or a plain array with ``fs`` or ``times``.
     centres : (M, 3) cap centres (e.g. a grid's or a mesh's vertices, for maps).
     radius : angular radius of the caps (rad), in (0, π/2).
     t_out : excursions outside a cap no longer than this (s) do not end a visit.
-    fs, times : sampling rate (Hz) or sample times (s).
+    fs, times : sampling rate (Hz) or sample times (s) of a plain array. Labelled data
+        use their ``time`` coordinate (else ``i / fs``); an ``fs`` contradicting
+        ``attrs["fs"]`` is an error.
     ref_times : (M,), optional
-        A time per centre; ``residence`` is then the residence time of the visit containing it.
+        A time per centre (on the data's clock); ``residence`` is then the residence time
+        of the visit containing it.
 
     Returns
     -------
     Residence
     """
-    _check(radius, t_out)
-    x, t = _series(vectors, fs, times)
+    radius, t_out = _check(radius, t_out)
+    x, t, _ = _series(vectors, fs, times)
     c = as_unit_vectors(centres, "centres")
-    ref = np.full(c.shape[0], np.nan) if ref_times is None else np.asarray(ref_times, float)
+    ref = (
+        np.full(c.shape[0], np.nan)
+        if ref_times is None
+        else np.asarray(ref_times, float)
+    )
     if ref.shape != (c.shape[0],):
         raise ValueError("ref_times must have shape (M,)")
     total, rt = np.empty(c.shape[0]), np.empty(c.shape[0])
@@ -164,29 +186,39 @@ def residence(vectors, centres, radius: float, t_out: float, *, fs: float | None
     return Residence(total, nv, mean, rt)
 
 
-def residence_series(vectors, radius: float, t_out: float, *, fs: float | None = None, times=None,
-                     stride: int = 1) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def residence_series(
+    vectors,
+    radius: float,
+    t_out: float,
+    *,
+    fs: float | None = None,
+    times=None,
+    stride: int = 1,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """App. C at the recorded locations: RT(i) and NV(i) for every ``stride``-th sample.
 
-    Returns ``(index, RT, NV)``. Cost O(N²/stride).
+    ``vectors``, ``fs`` and ``times`` as in :func:`residence`. Returns ``(index, RT, NV)``.
+    Cost O(N²/stride).
     """
-    _check(radius, t_out)
-    x, t = _series(vectors, fs, times)
-    if int(stride) < 1:
-        raise ValueError("stride must be >= 1")
-    idx = np.arange(0, x.shape[0], int(stride))
+    radius, t_out = _check(radius, t_out)
+    stride = _validate.integer(stride, "stride", minimum=1)
+    x, t, _ = _series(vectors, fs, times)
+    idx = np.arange(0, x.shape[0], stride)
     r = residence(x, x[idx], radius, t_out, times=t, ref_times=t[idx])
     return idx, r.residence, r.n_visits
 
 
-def passage_times(vectors, centre, radius: float, *, fs: float | None = None, times=None) -> tuple[np.ndarray, np.ndarray]:
+def passage_times(
+    vectors, centre, radius: float, *, fs: float | None = None, times=None
+) -> tuple[np.ndarray, np.ndarray]:
     """Entry and exit times (s) of the trajectory through the cap of angular ``radius`` around ``centre``.
 
-    Interpolated along the arcs (App. C). A series that starts (ends) inside enters at
-    its first (leaves at its last) sample time.
+    ``vectors``, ``fs`` and ``times`` as in :func:`residence`; times are on the data's
+    clock (its ``time`` coordinate when labelled). Interpolated along the arcs (App. C).
+    A series that starts (ends) inside enters at its first (leaves at its last) sample time.
     """
-    _check(radius, 0.0)
-    x, t = _series(vectors, fs, times)
+    radius, _ = _check(radius, 0.0)
+    x, t, _ = _series(vectors, fs, times)
     c = as_unit_vectors(centre, "centre")[0]
     inside = x @ c >= np.cos(radius)
     change = np.flatnonzero(np.diff(inside.astype(np.int8)))

@@ -39,7 +39,8 @@ from typing import NamedTuple
 import numpy as np
 import xarray as xr
 
-from .mesh import SphereMesh, as_unit_vectors, sphere_mesh
+from .. import _validate
+from .mesh import SphereMesh, _read, as_unit_vectors, sphere_mesh
 
 __all__ = [
     "VMFFit",
@@ -140,7 +141,11 @@ def a3_inverse(rbar, *, tol: float = 1e-13, max_iter: int = 100) -> np.ndarray:
         step = f / _a3_prime(k)
         k_new = k - step
         bad = ~((k_new > lo) & (k_new < hi)) | ~np.isfinite(k_new)
-        mid = np.where(hi > 2 * np.maximum(lo, 1e-300) + 1, np.sqrt(np.maximum(lo, 1e-12) * hi), 0.5 * (lo + hi))
+        mid = np.where(
+            hi > 2 * np.maximum(lo, 1e-300) + 1,
+            np.sqrt(np.maximum(lo, 1e-12) * hi),
+            0.5 * (lo + hi),
+        )
         k_new = np.where(bad, mid, k_new)
         done = np.abs(k_new - k) <= tol * np.maximum(k, 1.0)
         k = k_new
@@ -173,8 +178,9 @@ def vmf_fit(x, weights=None) -> VMFFit:
 
     Parameters
     ----------
-    x : array_like, shape (N, 3)
-        Directions (normalised here).
+    x : xarray.DataArray, xarray.Dataset or array_like, shape (N, 3)
+        Directions (normalised here): a labelled (time, axis) series (e.g.
+        :func:`tiltlab.filters.gravity`), a Recording (its ``gravity``) or an array.
     weights : array_like, shape (N,), optional
         Frequency weights (counts, durations); default 1.
 
@@ -202,11 +208,15 @@ def vmf_logpdf(x, mu, kappa: float) -> np.ndarray:
     r"""log of Eq. 14a, evaluated stably as :math:`\log\kappa-\log(2\pi(1-e^{-2\kappa}))+\kappa(\mu\cdot x-1)`."""
     x = np.asarray(x, float)
     mu = np.asarray(mu, float) / np.linalg.norm(mu)
-    if kappa < 0:
-        raise ValueError("kappa must be >= 0")
+    kappa = _validate.nonnegative(kappa, "kappa")
     if kappa == 0:
         return np.full(x.shape[:-1], -np.log(4 * np.pi))
-    return np.log(kappa) - np.log(2 * np.pi) - np.log1p(-np.exp(-2 * kappa)) + kappa * (x @ mu - 1.0)
+    return (
+        np.log(kappa)
+        - np.log(2 * np.pi)
+        - np.log1p(-np.exp(-2 * kappa))
+        + kappa * (x @ mu - 1.0)
+    )
 
 
 def vmf_pdf(x, mu, kappa: float) -> np.ndarray:
@@ -228,9 +238,9 @@ def vmf_sample(mu, kappa: float, n: int, rng=None) -> np.ndarray:
 
     :math:`w = \mu\cdot x = 1 + \log\big(u + (1-u)e^{-2\kappa}\big)/\kappa`, longitude uniform.
     """
+    kappa = _validate.nonnegative(kappa, "kappa")
+    n = _validate.integer(n, "n", minimum=0)
     rng = np.random.default_rng(rng)
-    if kappa < 0 or not np.isfinite(kappa):
-        raise ValueError("kappa must be finite and >= 0")
     u = rng.random(int(n))
     if kappa == 0:
         w = 2 * u - 1
@@ -255,8 +265,17 @@ def vmf_cap_area(kappa, level) -> np.ndarray:
     return -2 * np.pi * np.log1p(-p * (-np.expm1(-2 * k))) / k
 
 
-def vmf_bootstrap(x, weights=None, *, n_boot: int = 1000, level: float = 0.95, block: int = 1,
-                  rng=None) -> ConfidenceCone:
+def vmf_bootstrap(
+    x,
+    weights=None,
+    *,
+    n_boot: int = 1000,
+    level: float = 0.95,
+    block: int = 1,
+    block_s: float | None = None,
+    fs: float | None = None,
+    rng=None,
+) -> ConfidenceCone:
     r"""Bootstrap confidence cone for the vMF mean direction (and a percentile interval for κ).
 
     Each replicate resamples the data with replacement and refits μ and κ; the cone's
@@ -270,21 +289,32 @@ def vmf_bootstrap(x, weights=None, *, n_boot: int = 1000, level: float = 0.95, b
     * ``weights`` (frequency weights, e.g. counts per facet): replicates draw
       multinomial counts with probabilities :math:`w_i/\sum w` and total
       :math:`\mathrm{round}(\sum w)` (equivalent to resampling the underlying samples).
+
+    ``x`` is a labelled (time, axis) series, a Recording (its ``gravity``) or an (N, 3)
+    array. ``block_s`` gives the block length in seconds instead of samples
+    (``block = round(block_s · fs)``), with ``fs`` read from the data (or given for a
+    plain array; a missing or contradictory ``fs`` is an error).
     """
-    x = as_unit_vectors(x, "x")
+    sig = _read(x, name="x", fs=fs, need_fs=block_s is not None)
+    x = as_unit_vectors(sig.values, "x")
     n = x.shape[0]
     w = _weights(weights, n)
-    if not 0 < level < 1:
-        raise ValueError("level must be in (0, 1)")
-    if int(n_boot) < 2:
-        raise ValueError("n_boot must be >= 2")
+    level = _validate.fraction(level, "level", open_low=True, open_high=True)
+    n_boot = _validate.integer(n_boot, "n_boot", minimum=2)
+    if block_s is not None:
+        if block != 1:
+            raise ValueError("give block (samples) or block_s (seconds), not both")
+        block = max(1, int(round(_validate.positive(block_s, "block_s") * sig.fs)))
+    block = _validate.integer(block, "block", minimum=1)
     rng = np.random.default_rng(rng)
     fit = vmf_fit(x, w)
     nb_ = int(n_boot)
     S, N = np.empty((nb_, 3)), np.empty(nb_)
     if w is not None:
         if block != 1:
-            raise ValueError("block bootstrap is defined for unweighted time series only")
+            raise ValueError(
+                "block bootstrap is defined for unweighted time series only"
+            )
         tot, p = int(round(w.sum())), w / w.sum()
         for b in range(nb_):  # one vectorised draw per replicate (memory stays O(N))
             c = rng.multinomial(tot, p).astype(float)
@@ -294,12 +324,13 @@ def vmf_bootstrap(x, weights=None, *, n_boot: int = 1000, level: float = 0.95, b
             S[b] = x[rng.integers(0, n, n)].sum(axis=0)
         N[:] = n
     else:
-        block = int(block)
-        if not 1 < block <= n:
-            raise ValueError(f"block must be in [1, {n}]")
+        if block > n:
+            raise ValueError(f"block must be in [1, {n}], got {block}")
         xx = np.concatenate([x, x[: block - 1]])
         cs = np.concatenate([np.zeros((1, 3)), np.cumsum(xx, axis=0)])
-        bsum = cs[block:block + n] - cs[:n]  # (n, 3): sum over the circular block starting at i
+        bsum = (
+            cs[block : block + n] - cs[:n]
+        )  # (n, 3): sum over the circular block starting at i
         nblocks = int(np.ceil(n / block))
         for b in range(nb_):
             S[b] = bsum[rng.integers(0, n, nblocks)].sum(axis=0)
@@ -309,7 +340,15 @@ def vmf_bootstrap(x, weights=None, *, n_boot: int = 1000, level: float = 0.95, b
     angles = angle(mus, fit.mu)
     kap = a3_inverse(np.clip(rn / N, 0, 1))
     lo, hi = np.quantile(kap, [(1 - level) / 2, (1 + level) / 2])
-    return ConfidenceCone(fit.mu, fit.kappa, float(np.quantile(angles, level)), float(lo), float(hi), float(level), angles)
+    return ConfidenceCone(
+        fit.mu,
+        fit.kappa,
+        float(np.quantile(angles, level)),
+        float(lo),
+        float(hi),
+        float(level),
+        angles,
+    )
 
 
 # ---------------------------------------------------------------------------
@@ -377,12 +416,23 @@ def rotation_to_pole(point) -> np.ndarray:
     return np.eye(3) + vx + vx @ vx / (1.0 + c)
 
 
-def rotate_to_pole(vectors, baseline) -> np.ndarray:
+def rotate_to_pole(vectors, baseline):
     """Rotate directions so that ``baseline`` sits at the north pole (Fayat et al. Fig. 3e).
 
     Angles between directions are preserved; a point's distance to the pole afterwards
-    is its distance to the baseline point.
+    is its distance to the baseline point. ``vectors`` of shape (..., 3), or a labelled
+    (time, axis) series / a Recording (its ``gravity``), which gives a DataArray back
+    with the same coordinates and attributes.
     """
+    if isinstance(vectors, (xr.DataArray, xr.Dataset)):
+        sig = _read(vectors, allow_nan=True)
+        out = sig.values @ rotation_to_pole(baseline).T
+        attrs = {"units": "1", "long_name": "direction, baseline at the pole"}
+        if "method" in sig.attrs:
+            attrs["method"] = sig.attrs["method"]
+        return _validate.labelled(
+            out, sig, "rotated", dims=("time", "axis"), attrs=attrs
+        )
     v = np.asarray(vectors, float)
     if v.shape[-1] != 3:
         raise ValueError("vectors must have a last axis of length 3")

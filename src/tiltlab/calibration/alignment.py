@@ -1,5 +1,9 @@
-r"""Frames: head frame from motion-capture markers, marker quality control, IMU-to-head
-alignment (Kabsch) and device-to-body mounting angles.
+r"""Frame alignment: head frame from motion-capture markers, marker quality control,
+IMU-to-head alignment (Kabsch) and device-to-body mounting angles.
+
+The geometry itself (marker head frame, Benhamou's mounting angles) is implemented once,
+in :mod:`tiltlab.frames`; this module validates the inputs and solves the alignment
+problems.
 
 * Head frame from three markers (Fayat et al. 2021 [1]_ §2.6.4), with
   :math:`v_{21} = p_1 - p_2`, :math:`v_{23} = p_3 - p_2`:
@@ -12,9 +16,10 @@ alignment (Kabsch) and device-to-body mounting angles.
 * IMU→head alignment (§2.6.6): the rotation minimising the distance between the
   normalised low-passed (< 2 Hz) acceleration in the IMU frame and the vertical in the
   head frame during stillness — the Kabsch problem [2]_, solved by
-  :meth:`scipy.spatial.transform.Rotation.align_vectors`.
+  :meth:`scipy.spatial.transform.Rotation.align_vectors`. The low-pass is
+  :func:`tiltlab.dsp.lowpass` (zero-phase Butterworth).
 * Device→body mounting angles from a level-rest acceleration (Benhamou 2023 [3]_ Eq. 1),
-  delegated to :func:`tiltlab.trig.mounting_angles` / :func:`tiltlab.trig.mounting_matrix`.
+  delegated to :func:`tiltlab.frames.mounting_angles` / :func:`tiltlab.frames.mounting_matrix`.
 
 References
 ----------
@@ -29,12 +34,13 @@ from __future__ import annotations
 from typing import NamedTuple
 
 import numpy as np
-from scipy.signal import butter, sosfiltfilt
 from scipy.spatial.transform import Rotation
 
-from .. import quaternion as _quat
+from .. import _validate as _v
 from .. import frames as _frames
-from ._util import CalibrationError, check_fs, vec3
+from .. import quaternion as _quat
+from ..dsp import lowpass
+from ._util import CalibrationError, vec3
 
 __all__ = [
     "head_frame_from_markers",
@@ -42,7 +48,6 @@ __all__ = [
     "MarkerQC",
     "marker_distance_qc",
     "optical_tilt_uncertainty",
-    "lowpass",
     "Alignment",
     "imu_to_head_alignment",
     "mounting_rotation",
@@ -64,8 +69,12 @@ def head_frame_from_markers(p1, p2, p3) -> np.ndarray:
     n21 = np.linalg.norm(v21, axis=-1)
     ncz = np.linalg.norm(np.cross(v23, v21), axis=-1)
     ok = np.isfinite(ncz)  # frames with a missing (NaN) marker give NaN
-    if np.any(n21[ok] == 0) or np.any(ncz[ok] <= 1e-9 * n21[ok] * np.linalg.norm(v23, axis=-1)[ok]):
-        raise CalibrationError("coincident or collinear markers: the head frame is undefined")
+    if np.any(n21[ok] == 0) or np.any(
+        ncz[ok] <= 1e-9 * n21[ok] * np.linalg.norm(v23, axis=-1)[ok]
+    ):
+        raise CalibrationError(
+            "coincident or collinear markers: the head frame is undefined"
+        )
     return _frames.head_frame_from_markers(a, b, c)
 
 
@@ -87,10 +96,13 @@ class MarkerQC(NamedTuple):
 
 
 def optical_tilt_uncertainty(sigma, median_distance) -> float:
-    """Optical tilt uncertainty (°): arctan(σ_d / median d) (Fayat §2.6.3)."""
-    if not median_distance > 0:
-        raise ValueError("median_distance must be positive")
-    return float(np.degrees(np.arctan(float(sigma) / float(median_distance))))
+    """Optical tilt uncertainty (°): arctan(σ_d / median d) (Fayat §2.6.3).
+
+    ``sigma`` and ``median_distance`` are in the same length unit (e.g. mm).
+    """
+    sigma = _v.nonnegative(sigma, "sigma")
+    median_distance = _v.positive(median_distance, "median_distance")
+    return float(np.degrees(np.arctan(sigma / median_distance)))
 
 
 def marker_distance_qc(p1, p2, *, drop_fraction: float = 0.02) -> MarkerQC:
@@ -99,11 +111,13 @@ def marker_distance_qc(p1, p2, *, drop_fraction: float = 0.02) -> MarkerQC:
     Frames with a missing marker (NaN) are dropped as well and do not count in the
     fraction.
     """
-    a, b = np.asarray(p1, float), np.asarray(p2, float)
-    if a.shape != b.shape or a.shape[-1] != 3:
-        raise ValueError("p1 and p2 must have the same shape (N, 3)")
-    if not 0 <= drop_fraction < 1:
-        raise ValueError("drop_fraction must be in [0, 1)")
+    a = _v.vectors(p1, "p1", allow_nan=True)
+    b = _v.vectors(p2, "p2", allow_nan=True)
+    if a.shape != b.shape:
+        raise ValueError(
+            f"p1 and p2 must have the same shape (N, 3), got {a.shape} and {b.shape}"
+        )
+    drop_fraction = _v.fraction(drop_fraction, "drop_fraction", open_high=True)
     d = np.linalg.norm(a - b, axis=-1)
     ok = np.isfinite(d)
     if ok.sum() < 3:
@@ -113,18 +127,9 @@ def marker_distance_qc(p1, p2, *, drop_fraction: float = 0.02) -> MarkerQC:
     n_drop = int(np.ceil(drop_fraction * ok.sum()))
     keep = ok.copy()
     if n_drop:
-        keep[np.argsort(dev, kind="stable")[ok.sum() - n_drop: ok.sum()]] = False
+        keep[np.argsort(dev, kind="stable")[ok.sum() - n_drop : ok.sum()]] = False
     s_all, s_kept = float(np.std(d[ok], ddof=1)), float(np.std(d[keep], ddof=1))
     return MarkerQC(keep, d, med, s_all, s_kept, optical_tilt_uncertainty(s_kept, med))
-
-
-def lowpass(x, fs: float, cutoff_hz: float = 2.0, order: int = 2) -> np.ndarray:
-    """Forward–backward Butterworth low-pass (zero phase), as in Fayat §2.6.5."""
-    fs = check_fs(fs)
-    if not 0 < cutoff_hz < fs / 2:
-        raise ValueError("cutoff_hz must be between 0 and the Nyquist frequency")
-    sos = butter(order, cutoff_hz, btype="low", fs=fs, output="sos")
-    return sosfiltfilt(sos, np.asarray(x, float), axis=0)
 
 
 class Alignment(NamedTuple):
@@ -137,38 +142,56 @@ class Alignment(NamedTuple):
     n: int
 
 
-def imu_to_head_alignment(acc, tilt_head, fs: float, *, still=None, cutoff_hz: float = 2.0,
-                          min_spread_deg: float = 5.0) -> Alignment:
-    r"""Rotation R (IMU→head) minimising :math:`\sum_t \|R\,\hat a_t - z^h_t\|^2` over still samples (Kabsch).
+def imu_to_head_alignment(
+    acc,
+    tilt_head,
+    fs: float | None = None,
+    *,
+    still=None,
+    cutoff_hz: float = 2.0,
+    min_spread_deg: float = 5.0,
+) -> Alignment:
+    r"""Rotation R (IMU→head) minimising :math:`\sum_t \|R\,\hat a_t - z^h_t\|^2` over
+    still samples (Kabsch).
 
     Parameters
     ----------
-    acc : array_like (N, 3)
-        IMU acceleration (any unit; it is normalised after low-pass filtering).
-    tilt_head : array_like (N, 3)
-        Vertical in the head frame from motion capture (:func:`tilt_from_markers`).
-    fs : float
-        Sampling rate (Hz) of both (already synchronised) streams.
+    acc : Recording, DataArray or array_like (N, 3)
+        IMU acceleration (a Recording's ``acc``; any unit: it is normalised after
+        low-pass filtering).
+    tilt_head : DataArray or array_like (N, 3)
+        Vertical in the head frame from motion capture (:func:`tilt_from_markers`);
+        NaN where the markers are missing or dropped.
+    fs : float, optional
+        Sampling rate (Hz) of both (already synchronised) streams; read from the attrs
+        of labelled input, mandatory for plain arrays.
     still : array_like (N,) of bool, optional
         Samples to use (immobility); default all finite ones.
     cutoff_hz : float
-        Low-pass cut-off (2 Hz in Fayat et al.).
+        Low-pass cut-off (Hz; 2 Hz in Fayat et al.), :func:`tiltlab.dsp.lowpass`.
     min_spread_deg : float
         The rotation about a single gravity direction is unobservable: the used tilts
-        must spread over at least this angle from their mean, else
+        must spread over at least this angle (°) from their mean, else
         :class:`CalibrationError`.
     """
-    a = vec3(acc, "acc", ndim=2)
-    z = np.asarray(tilt_head, float)
+    sa = _v.signal(acc, "acc", fs=fs)
+    a, fs = sa.values, sa.fs
+    z = _v.signal(tilt_head, "tilt_head", fs=fs, allow_nan=True).values
     if z.shape != a.shape:
-        raise ValueError("acc and tilt_head must have the same shape")
+        raise ValueError(
+            f"acc and tilt_head must have the same shape, got {a.shape} and {z.shape}"
+        )
+    cutoff_hz = _v.positive(cutoff_hz, "cutoff_hz")
+    min_spread_deg = _v.nonnegative(min_spread_deg, "min_spread_deg")
     alp = lowpass(a, fs, cutoff_hz)
     u = alp / np.linalg.norm(alp, axis=1, keepdims=True)
     use = np.all(np.isfinite(z), axis=1)
     if still is not None:
         s = np.asarray(still, bool)
         if s.shape != (a.shape[0],):
-            raise ValueError("still must have one value per sample")
+            raise ValueError(
+                f"still must have one value per sample ({a.shape[0]}), got shape {s.shape}"
+            )
         use &= s
     if use.sum() < 3:
         raise CalibrationError("fewer than three usable still samples")
@@ -176,12 +199,19 @@ def imu_to_head_alignment(acc, tilt_head, fs: float, *, still=None, cutoff_hz: f
     m = zu.mean(axis=0)
     spread = np.degrees(np.max(np.arccos(np.clip(zu @ (m / np.linalg.norm(m)), -1, 1))))
     if spread < min_spread_deg:
-        raise CalibrationError(f"still tilts span only {spread:.2f}° (< {min_spread_deg}°): the rotation about "
-                               "gravity is not determined")
+        raise CalibrationError(
+            f"still tilts span only {spread:.2f}° (< min_spread_deg = {min_spread_deg}°): "
+            "the rotation about gravity is not determined"
+        )
     rot, rssd = Rotation.align_vectors(zu, u[use])
     R = rot.as_matrix()
     ang = _quat.angle_between(u[use] @ R.T, zu)
-    return Alignment(R, _quat.from_scipy(rot), float(np.degrees(np.sqrt(np.mean(ang**2)))), int(use.sum()))
+    return Alignment(
+        R,
+        _quat.from_scipy(rot),
+        float(np.degrees(np.sqrt(np.mean(ang**2)))),
+        int(use.sum()),
+    )
 
 
 def mounting_rotation(acc_rest) -> np.ndarray:

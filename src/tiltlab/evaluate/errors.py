@@ -1,0 +1,433 @@
+r"""Error definitions and statistics: per-sample tilt errors, BROAD's RMSEs, Fayat's
+Table-1 statistics, error versus angular speed, empirical CDFs and agreement between
+estimates.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping, Sequence
+from typing import Any
+
+import numpy as np
+import pandas as pd
+import xarray as xr
+
+from .. import quaternion as quat
+
+__all__ = [
+    "STATES",
+    "STATISTICS",
+    "FAYAT_TABLE1",
+    "shift_quaternions",
+    "shifted_score",
+    "tilt_errors",
+    "error_stats",
+    "table1",
+    "state_scores",
+    "binned_by_speed",
+    "ecdf",
+    "pairwise_tilt_rms",
+    "broad_errors",
+    "tilt_rmse",
+]
+
+#: Behavioural states of Table 1 (plus ``all`` in :func:`state_scores`).
+STATES = ("immobile", "moving")
+#: Statistics of Table 1, in order.
+STATISTICS = ("mean", "std", "median", "q25", "q75", "q95")
+
+#: Fayat et al. (2021) Table 1 [1]_: angular errors (degrees) of IMU head-tilt
+#: estimation against optical motion capture in freely moving rats (36 min, 300 Hz),
+#: with the optimal parameters of their grid search (low-pass 2 Hz; Madgwick β = 0.1;
+#: Mahony kp = 0.3, kI = 1.8; EKF v_g = 1.0 deg² s⁻², v_a = 0.002 g²). Published
+#: numbers, transcribed from the paper.
+FAYAT_TABLE1 = pd.DataFrame(
+    {
+        ("immobile", "lowpass"): [0.43, 0.41, 0.32, 0.18, 0.55, 1.16],
+        ("immobile", "madgwick"): [0.36, 0.25, 0.31, 0.19, 0.47, 0.81],
+        ("immobile", "mahony"): [0.39, 0.25, 0.35, 0.20, 0.52, 0.83],
+        ("immobile", "ekf"): [0.44, 0.27, 0.39, 0.24, 0.58, 0.91],
+        ("moving", "lowpass"): [3.08, 2.58, 2.44, 1.35, 4.12, 7.67],
+        ("moving", "madgwick"): [1.56, 1.23, 1.27, 0.73, 2.08, 3.83],
+        ("moving", "mahony"): [1.52, 1.26, 1.19, 0.67, 2.00, 3.87],
+        ("moving", "ekf"): [1.17, 0.99, 0.93, 0.53, 1.55, 2.99],
+    },
+    index=pd.Index(STATISTICS, name="statistic"),
+)
+FAYAT_TABLE1.columns.names = ["state", "method"]
+
+
+def _quat_array(q, name: str) -> np.ndarray:
+    if isinstance(q, xr.DataArray):
+        if "quat" not in q.dims:
+            raise ValueError(f"{name} must have a 'quat' dimension, got {q.dims}")
+        q = q.transpose(..., "quat").values
+    q = np.asarray(q, dtype=float)
+    if q.ndim != 2 or q.shape[1] != 4:
+        raise ValueError(f"{name} must have shape (N, 4), got {q.shape}")
+    return q
+
+
+def shift_quaternions(q, samples: float) -> np.ndarray:
+    r"""Resample an orientation series at times shifted by ``samples`` sampling intervals.
+
+    ``out[k] = q(k + samples)`` by normalised linear interpolation (nlerp, sign-aligned)
+    between neighbouring samples; times outside the series take the end values. A
+    positive shift advances the series (compensates an estimate that *lags* its
+    reference by ``samples / fs`` seconds).
+
+    Parameters
+    ----------
+    q : array_like or xarray.DataArray, shape (N, 4)
+        Unit quaternions (w, x, y, z).
+    samples : float
+        Shift in samples (fractional allowed).
+
+    Returns
+    -------
+    numpy.ndarray, shape (N, 4)
+    """
+    q = _quat_array(q, "q")
+    s = float(samples)
+    if not np.isfinite(s):
+        raise ValueError(f"samples must be finite, got {samples!r}")
+    n = q.shape[0]
+    if n < 2 or s == 0.0:
+        return q.copy()
+    x = np.clip(np.arange(n) + s, 0.0, n - 1.0)
+    i = np.minimum(np.floor(x).astype(np.int64), n - 2)
+    f = (x - i)[:, None]
+    a, b = q[i], q[i + 1]
+    b = np.where(np.sum(a * b, axis=1, keepdims=True) < 0, -b, b)
+    return quat.normalize((1.0 - f) * a + f * b)
+
+
+def tilt_errors(q_est, ref) -> np.ndarray:
+    r"""Per-sample tilt error (degrees) between an estimate and a reference.
+
+    Parameters
+    ----------
+    q_est : array_like or xarray.DataArray, shape (N, 4)
+        Estimated orientations (sensor → world).
+    ref : array_like, shape (N, 4) or (N, 3)
+        Reference quaternions, or reference gravity-up directions in the sensor frame
+        (any norm). Rows with NaN give NaN.
+
+    Returns
+    -------
+    numpy.ndarray, shape (N,)
+        :math:`\arccos(\hat g \cdot g_{ref})` in degrees.
+    """
+    q = _quat_array(q_est, "q_est")
+    r = ref.values if isinstance(ref, xr.DataArray) else np.asarray(ref, dtype=float)
+    if r.ndim != 2 or r.shape[0] != q.shape[0] or r.shape[1] not in (3, 4):
+        raise ValueError(
+            f"ref must have shape ({q.shape[0]}, 4) or ({q.shape[0]}, 3), got {r.shape}"
+        )
+    bad = ~np.all(np.isfinite(r), axis=1) | ~np.all(np.isfinite(q), axis=1)
+    if r.shape[1] == 4:
+        r = quat.gravity(np.where(bad[:, None], [1.0, 0.0, 0.0, 0.0], r))
+    else:
+        nr = np.linalg.norm(np.where(bad[:, None], 1.0, r), axis=1, keepdims=True)
+        r = np.where(bad[:, None], [0.0, 0.0, 1.0], r / np.where(nr == 0, 1.0, nr))
+    g = quat.gravity(np.where(bad[:, None], [1.0, 0.0, 0.0, 0.0], q))
+    e = np.degrees(quat.angle_between(g, r))
+    e[bad] = np.nan
+    return e
+
+
+def _valid_mask(q_est: np.ndarray, rec: xr.Dataset, movement_only: bool) -> np.ndarray:
+    q_ref = rec["q_ref"].transpose("time", "quat").values
+    mask = np.all(np.isfinite(q_ref), axis=1) & np.all(np.isfinite(q_est), axis=1)
+    if movement_only:
+        if "movement" not in rec:
+            raise ValueError(
+                "recording has no 'movement' variable; pass movement_only=False"
+            )
+        mask &= rec["movement"].values.astype(bool)
+    return mask
+
+
+def broad_errors(
+    q_est,
+    rec: xr.Dataset,
+    *,
+    movement_only: bool = True,
+    remove_heading_offset: bool = False,
+) -> dict[str, float]:
+    r"""RMSE (degrees) of inclination (= tilt), heading and total error, BROAD's definition.
+
+    Error quaternion in the earth frame :math:`e = q_{est} \otimes q_{ref}^{-1}`; total
+    :math:`2\arccos|e_w|`, heading :math:`2\arctan|e_z/e_w|`, inclination
+    :math:`2\arccos\sqrt{e_w^2+e_z^2}` (:func:`tiltlab.quaternion.tilt_error` etc.).
+    RMS over the samples where ``movement`` is true (BROAD's rule) and the reference
+    is valid (NaN where optical tracking was lost).
+
+    Parameters
+    ----------
+    q_est : xarray.DataArray or array_like, shape (N, 4)
+    rec : xarray.Dataset
+        Recording with ``q_ref`` (and ``movement``).
+    remove_heading_offset : bool
+        Remove the constant heading offset between the estimate's and the reference's
+        world frames first (circular mean over the valid samples). BROAD does not do
+        this; use it for 6D methods, whose heading origin is arbitrary. The inclination
+        error is unaffected.
+
+    Returns
+    -------
+    dict
+        ``inclination``, ``heading``, ``total`` (degrees) and ``n`` (samples used).
+    """
+    if "q_ref" not in rec:
+        raise ValueError("recording has no 'q_ref' (reference orientation)")
+    q = (
+        q_est.transpose("time", "quat").values
+        if isinstance(q_est, xr.DataArray)
+        else np.asarray(q_est, float)
+    )
+    if q.shape != (rec.sizes["time"], 4):
+        raise ValueError(
+            f"q_est must have shape ({rec.sizes['time']}, 4), got {q.shape}"
+        )
+    mask = _valid_mask(q, rec, movement_only)
+    if not mask.any():
+        raise ValueError("no valid samples (movement with a finite reference)")
+    qe, qr = q[mask], rec["q_ref"].transpose("time", "quat").values[mask]
+    if remove_heading_offset:
+        e = quat.error_quaternion(qe, qr)
+        e = np.where(e[:, :1] < 0, -e, e)
+        psi = 2.0 * np.arctan2(e[:, 3], e[:, 0])
+        off = np.arctan2(np.mean(np.sin(psi)), np.mean(np.cos(psi)))
+        qe = quat.mul(np.array([np.cos(off / 2), 0.0, 0.0, -np.sin(off / 2)]), qe)
+    err = quat.error_angles(qe, qr)
+
+    def rms(v):
+        return float(np.degrees(np.sqrt(np.mean(v * v))))
+
+    return {
+        "inclination": rms(err[:, 2]),
+        "heading": rms(err[:, 1]),
+        "total": rms(err[:, 0]),
+        "n": int(mask.sum()),
+    }
+
+
+def tilt_rmse(q_est, rec: xr.Dataset) -> float:
+    """Inclination RMSE (degrees) over BROAD's movement samples: a ``score_fn`` for :func:`grid_search`."""
+    return broad_errors(q_est, rec)["inclination"]
+
+
+def shifted_score(
+    shifts: Sequence[float], score_fn: Callable[[Any, xr.Dataset], float] | None = None
+) -> Callable[[Any, xr.Dataset], xr.DataArray]:
+    """A ``score_fn`` for :func:`grid_search` that scores the estimate at
+    several time shifts (:func:`shift_quaternions`, in samples): returns a DataArray over
+    ``shift``, so that the shift is one more dimension of the grid (and of LOTO selection).
+    The same shifts must be applied to every method compared."""
+    sh = np.asarray(shifts, dtype=float).ravel()
+    if sh.size == 0 or not np.all(np.isfinite(sh)):
+        raise ValueError("shifts must be a non-empty sequence of finite numbers")
+    fn = score_fn or tilt_rmse
+
+    def score(q, rec):
+        return xr.DataArray(
+            [float(fn(shift_quaternions(q, d), rec)) for d in sh],
+            dims=("shift",),
+            coords={"shift": sh},
+        )
+
+    return score
+
+
+def error_stats(errors, mask=None) -> dict[str, float]:
+    """Table-1 statistics (mean, std, median, Q25, Q75, Q95) of finite errors, plus ``n``
+    and ``rmse``; ``mask`` selects samples. NaN statistics when nothing is selected."""
+    e = np.asarray(errors, dtype=float).ravel()
+    if mask is not None:
+        m = np.asarray(mask, dtype=bool).ravel()
+        if m.shape != e.shape:
+            raise ValueError(f"mask has {m.size} samples, errors {e.size}")
+        e = e[m]
+    e = e[np.isfinite(e)]
+    if e.size == 0:
+        return {**{k: float("nan") for k in STATISTICS}, "rmse": float("nan"), "n": 0}
+    q25, med, q75, q95 = np.percentile(e, [25, 50, 75, 95])
+    return {
+        "mean": float(e.mean()),
+        "std": float(e.std(ddof=1)) if e.size > 1 else 0.0,
+        "median": float(med),
+        "q25": float(q25),
+        "q75": float(q75),
+        "q95": float(q95),
+        "rmse": float(np.sqrt(np.mean(e * e))),
+        "n": int(e.size),
+    }
+
+
+def table1(
+    errors: Mapping[str, Any], immobile, *, statistics: Sequence[str] = STATISTICS
+) -> pd.DataFrame:
+    """Fayat-style Table 1: statistics of per-sample errors during immobility and movement.
+
+    Parameters
+    ----------
+    errors : mapping
+        Method name → per-sample errors (degrees), all of the same length (NaN = no
+        reference). Several sessions may be concatenated.
+    immobile : array_like of bool
+        Immobility mask of the same length.
+
+    Returns
+    -------
+    pandas.DataFrame
+        Index ``statistic``; columns MultiIndex (``state`` ∈ immobile, moving;
+        ``method``), like :data:`FAYAT_TABLE1`.
+    """
+    if not errors:
+        raise ValueError("errors is empty")
+    im = np.asarray(immobile, dtype=bool).ravel()
+    cols = {}
+    for state, m in (("immobile", im), ("moving", ~im)):
+        for name, e in errors.items():
+            st = error_stats(e, m)
+            cols[(state, name)] = [st[s] for s in statistics]
+    df = pd.DataFrame(cols, index=pd.Index(list(statistics), name="statistic"))
+    df.columns.names = ["state", "method"]
+    return df
+
+
+def state_scores(
+    q,
+    rec: xr.Dataset,
+    *,
+    ref: str = "tilt_ref",
+    state: str = "immobile",
+    stat: str = "mean",
+) -> xr.DataArray:
+    """Tilt-error statistic per behavioural state: a DataArray-valued ``score_fn`` for
+    :func:`grid_search` (dims ``state`` = immobile, moving, all).
+
+    Parameters
+    ----------
+    q : array_like (N, 4)
+        Estimate.
+    rec : xarray.Dataset
+        Recording with the reference ``ref`` (quaternions (time, quat) or gravity-up
+        directions (time, axis)) and a boolean ``state`` variable (True = immobile).
+    stat : str
+        One of :data:`STATISTICS` or ``"rmse"``.
+    """
+    if ref not in rec or state not in rec:
+        raise ValueError(f"recording needs variables {ref!r} and {state!r}")
+    if stat not in STATISTICS + ("rmse",):
+        raise ValueError(f"stat must be one of {STATISTICS + ('rmse',)}, got {stat!r}")
+    e = tilt_errors(q, rec[ref].values)
+    im = rec[state].values.astype(bool)
+    vals = [error_stats(e, im)[stat], error_stats(e, ~im)[stat], error_stats(e)[stat]]
+    return xr.DataArray(
+        vals, dims=("state",), coords={"state": ["immobile", "moving", "all"]}
+    )
+
+
+def binned_by_speed(errors: Mapping[str, Any], speed, edges) -> xr.Dataset:
+    """Median and interquartile range of errors by angular-speed bin (Fayat Fig. 2f).
+
+    Parameters
+    ----------
+    errors : mapping
+        Method → per-sample errors (degrees).
+    speed : array_like
+        Angular speed (°/s), same length.
+    edges : array_like
+        Bin edges (°/s), increasing.
+
+    Returns
+    -------
+    xarray.Dataset
+        Variables ``median``, ``q25``, ``q75``, ``n`` with dims (estimator, speed); the
+        ``speed`` coordinate is the bin centre, ``speed_lo``/``speed_hi`` the edges.
+    """
+    edges = np.asarray(edges, dtype=float)
+    if edges.ndim != 1 or edges.size < 2 or np.any(np.diff(edges) <= 0):
+        raise ValueError(
+            "edges must be a 1-D increasing array with at least two values"
+        )
+    sp = np.asarray(speed, dtype=float).ravel()
+    idx = np.digitize(sp, edges) - 1
+    nb = edges.size - 1
+    names = list(errors)
+    out = {k: np.full((len(names), nb), np.nan) for k in ("median", "q25", "q75")}
+    cnt = np.zeros((len(names), nb), dtype=np.int64)
+    for i, name in enumerate(names):
+        e = np.asarray(errors[name], dtype=float).ravel()
+        if e.shape != sp.shape:
+            raise ValueError(f"errors[{name!r}] has {e.size} samples, speed {sp.size}")
+        for b in range(nb):
+            v = e[(idx == b) & np.isfinite(e)]
+            cnt[i, b] = v.size
+            if v.size:
+                out["q25"][i, b], out["median"][i, b], out["q75"][i, b] = np.percentile(
+                    v, [25, 50, 75]
+                )
+    dims = (
+        "estimator",
+        "speed",
+    )  # not "method": it would clash with the ``method`` argument of ``.sel``
+    coords = {
+        "estimator": names,
+        "speed": 0.5 * (edges[:-1] + edges[1:]),
+        "speed_lo": ("speed", edges[:-1]),
+        "speed_hi": ("speed", edges[1:]),
+    }
+    return xr.Dataset(
+        {**{k: (dims, v, {"units": "deg"}) for k, v in out.items()}, "n": (dims, cnt)},
+        coords=coords,
+    )
+
+
+def ecdf(values) -> tuple[np.ndarray, np.ndarray]:
+    """Empirical CDF of the finite values: sorted ``x`` and ``F(x) = i / n`` (i = 1…n)."""
+    v = np.asarray(values, dtype=float).ravel()
+    v = np.sort(v[np.isfinite(v)])
+    if v.size == 0:
+        raise ValueError("no finite values")
+    return v, np.arange(1, v.size + 1) / v.size
+
+
+def pairwise_tilt_rms(estimates: Mapping[str, Any], mask=None) -> xr.DataArray:
+    """RMS tilt difference (degrees) between every pair of estimates of the same recording
+    (agreement between filters when there is no ground truth).
+
+    Parameters
+    ----------
+    estimates : mapping
+        Method → quaternions (N, 4), all the same length.
+    mask : array_like of bool, optional
+        Samples to use (e.g. movement only).
+
+    Returns
+    -------
+    xarray.DataArray
+        Dims (estimator, other), symmetric with a zero diagonal.
+    """
+    names = list(estimates)
+    if len(names) < 2:
+        raise ValueError("need at least two estimates")
+    g = {k: quat.gravity(_quat_array(v, k)) for k, v in estimates.items()}
+    n = g[names[0]].shape[0]
+    if any(v.shape[0] != n for v in g.values()):
+        raise ValueError("all estimates must have the same length")
+    m = np.ones(n, bool) if mask is None else np.asarray(mask, bool)
+    out = np.zeros((len(names), len(names)))
+    for i, a in enumerate(names):
+        for j in range(i + 1, len(names)):
+            d = np.degrees(quat.angle_between(g[a][m], g[names[j]][m]))
+            out[i, j] = out[j, i] = float(np.sqrt(np.mean(d * d)))
+    return xr.DataArray(
+        out,
+        dims=("estimator", "other"),
+        coords={"estimator": names, "other": names},
+        name="tilt_rms_difference",
+        attrs={"units": "deg"},
+    )

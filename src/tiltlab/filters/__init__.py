@@ -1,0 +1,173 @@
+r"""Orientation filters: numba kernels, one method registry and the :func:`estimate`
+wrapper (layer 5).
+
+Every filter turns a Recording's accelerometer (specific force), gyroscope and
+optionally magnetometer samples into unit quaternions ``q`` (scalar first) that
+rotate **sensor → world**, world z up. With a magnetometer ("9D") the world frame
+is ENU (x east, y magnetic north, z up); without one ("6D") the heading of the
+world frame is arbitrary (fixed by the initial orientation).
+
+Methods
+-------
+``lowpass``
+    Tilt from the normalised, zero-phase low-passed accelerometer (2nd-order
+    Butterworth, forward–backward; scipy). 6D only, heading zero.
+``complementary``
+    Gyroscope integration corrected towards the accelerometer (and magnetometer)
+    by geometric rotations in the world frame, with time constants.
+``madgwick``
+    Gradient-descent correction (Madgwick 2010/2011).
+``mahony``
+    Explicit complementary filter with proportional and integral (gyro bias) terms
+    (Mahony 2008).
+``ekf``
+    Quaternion-state extended Kalman filter with the gravity (and magnetic field)
+    direction as measurement (the formulation of the ``ahrs`` package).
+``smoother``
+    Offline (non-causal) tilt: rest-detected gyro bias, strapdown integration, and a
+    zero-phase low-pass of the specific force expressed in the integrated frame; for
+    post-hoc analysis.
+``rts_smoother``
+    Offline error-state EKF (attitude, gyro bias and scale, velocity, position; zero-velocity
+    and bounded-position pseudo-measurements, adaptive accelerometer weighting) with a
+    Rauch–Tung–Striebel backward pass.
+``vqf``, ``offline_vqf``
+    Adapters to the ``vqf`` package (Laidig & Seel 2023), for comparison.
+``imufusion``
+    Adapter to the ``imufusion`` package (x-io Fusion AHRS, 6D), for comparison.
+``ahrs_madgwick``, ``ahrs_mahony``, ``ahrs_ekf``
+    Adapters to the pure-Python ``ahrs`` package (6D; slow: use short recordings), for
+    comparison; the EKF runs with ``frame='NED'`` (really z up, see below).
+
+Package layout
+--------------
+One module per method family — :mod:`~tiltlab.filters.lowpass`,
+:mod:`~tiltlab.filters.complementary`, :mod:`~tiltlab.filters.madgwick`,
+:mod:`~tiltlab.filters.mahony`, :mod:`~tiltlab.filters.ekf`,
+:mod:`~tiltlab.filters.smoothers` (``smoother``, ``rest_gyro_bias``),
+:mod:`~tiltlab.filters.rts` and :mod:`~tiltlab.filters.adapters` — plus
+:mod:`~tiltlab.filters.registry` (:data:`METHODS`: each method's function, whether it
+supports a magnetometer, and its parameter defaults, read from the function's
+signature: the one place they are written) and :mod:`~tiltlab.filters.recordings`
+(:func:`estimate`, :func:`gravity`). The array functions take SI inputs (``acc`` m/s²
+or any unit where only its direction matters, ``gyr`` rad/s) and a mandatory ``fs``;
+durations end in ``_s``, frequencies in ``_hz``. Scoring against references
+(``broad_errors``, ``tilt_rmse``, ``grid_search``) lives in :mod:`tiltlab.evaluate`.
+
+Sample indexing
+---------------
+All recursive filters use the convention of the ``ahrs`` package: ``q[0]`` is the
+initial orientation and ``q[k]`` is obtained from ``q[k-1]`` with the samples of
+index ``k`` (gyroscope ``ω_k`` over ``Δt = 1/fs``, then the correction with
+``a_k`` and ``m_k``). This differs by one sample from
+:func:`tiltlab.quaternion.integrate_gyro`, which uses ``ω_k`` to go from ``k`` to
+``k+1``.
+
+Madgwick and Mahony evaluate their correction at the prior ``q[k-1]`` against ``a_k``
+(as in ``ahrs`` and Madgwick's reference code [5]_): under rotation at rate ``|ω|``
+this one-sample lag biases the tilt by up to ``|ω|·Δt`` rad. The EKF and the
+complementary filter predict first and have no such lag. Madgwick's normalised
+gradient step never vanishes, so at rest its estimate chatters within ``2·β·Δt`` rad.
+
+Parity with ``ahrs`` 0.4.0 and its defects
+-----------------------------------------
+For identical parameters, sampling interval and initial state, :func:`madgwick`,
+:func:`mahony` and :func:`ekf` reproduce ``ahrs.filters.Madgwick``, ``Mahony`` and
+``EKF`` to ~1e-13 (tests assert 1e-10), except where ``ahrs`` is wrong; those
+defects are *not* inherited:
+
+* ``ahrs`` silently assumes 100 Hz when ``frequency`` is not given; here ``fs`` is
+  mandatory.
+* ``ahrs`` Madgwick and Mahony skip the whole update (accelerometer correction and
+  bias integration included) when the gyroscope sample is exactly zero; here the
+  correction is always applied. The EKF of ``ahrs`` skips the gyroscope prediction
+  when the accelerometer sample is zero; here the prediction is always made.
+* ``ahrs`` EKF with ``frame='ENU'`` uses the reference gravity ``(0, 0, -1)``
+  although an accelerometer at rest measures the specific force *up*, so its
+  output is upside down. Its ``frame='NED'`` uses ``(0, 0, 1)``, i.e. it is really
+  a z-up filter; the parity test therefore compares with ``frame='NED'`` and an
+  explicit ENU magnetic reference ``magnetic_ref=(0, cos δ, −sin δ)``.
+* ``ahrs`` EKF without ``magnetic_ref`` silently uses the field of Munich (WMM);
+  here the dip angle is a parameter or is measured from the initial samples.
+* ``ahrs`` Madgwick MARG works in Madgwick's NWU earth frame (x magnetic north,
+  z up) but initialises with ``ecompass(..., frame='NED')``; it also ignores
+  ``q0`` with a magnetometer. Here the filter runs in Madgwick's frame internally
+  and inputs/outputs are converted to ENU, ``q_ENU = R_z(90°) ⊗ q_NWU``.
+  The parity test checks exactly this transformation.
+* ``ahrs`` Madgwick divides by the norm of the gradient without checking it; here a
+  zero gradient skips the correction.
+
+References
+----------
+.. [1] S. O. H. Madgwick, A. J. L. Harrison, R. Vaidyanathan, "Estimation of IMU and
+   MARG orientation using a gradient descent algorithm", IEEE ICORR 2011.
+   doi:10.1109/ICORR.2011.5975346
+.. [2] R. Mahony, T. Hamel, J.-M. Pflimlin, "Nonlinear complementary filters on the
+   special orthogonal group", IEEE TAC 53(5):1203–1218, 2008.
+   doi:10.1109/TAC.2008.923738
+.. [3] R. G. Valenti, I. Dryanovski, J. Xiao, "Keeping a good attitude: a
+   quaternion-based orientation filter for IMUs and MARGs", Sensors 15(8):19302, 2015.
+   doi:10.3390/s150819302
+.. [4] J. L. Crassidis, F. L. Markley, Y. Cheng, "Survey of nonlinear attitude
+   estimation methods", J. Guid. Control Dyn. 30(1):12–28, 2007. doi:10.2514/1.22452
+.. [5] S. O. H. Madgwick, "An efficient orientation filter for inertial and
+   inertial/magnetic sensor arrays", report, University of Bristol, 2010.
+.. [6] M. D. Shuster, S. D. Oh, "Three-axis attitude determination from vector
+   observations", J. Guid. Control 4(1):70–77, 1981. doi:10.2514/3.19717
+.. [7] D. Laidig, T. Seel, "VQF: Highly accurate IMU orientation estimation with bias
+   estimation and magnetic disturbance rejection", Information Fusion 91:187–204,
+   2023. doi:10.1016/j.inffus.2022.10.014
+.. [8] D. Laidig, M. Caruso, A. Cereatti, T. Seel, "BROAD — A Benchmark for Robust
+   Inertial Orientation Estimation", Data 6(7):72, 2021. doi:10.3390/data6070072
+.. [9] M. Garillos-Manliguez (ahrs), "AHRS: Attitude and Heading Reference Systems",
+   Python package, version 0.4.0.
+"""
+
+from ._common import initial_orientation, tilt_quaternion
+from .adapters import (
+    run_ahrs_ekf,
+    run_ahrs_madgwick,
+    run_ahrs_mahony,
+    run_imufusion,
+    run_offline_vqf,
+    run_vqf,
+)
+from .complementary import complementary
+from .ekf import ekf
+from .lowpass import lowpass_tilt
+from .madgwick import madgwick, madgwick_batch
+from .mahony import mahony
+from .recordings import Inputs, estimate, gravity, prepare, run
+from .registry import METHODS, Method, defaults, get_method, methods
+from .rts import rts_smoother
+from .smoothers import rest_gyro_bias, smoother
+
+__all__ = [
+    "METHODS",
+    "Method",
+    "methods",
+    "get_method",
+    "defaults",
+    "estimate",
+    "gravity",
+    "prepare",
+    "run",
+    "Inputs",
+    "initial_orientation",
+    "tilt_quaternion",
+    "lowpass_tilt",
+    "complementary",
+    "madgwick",
+    "madgwick_batch",
+    "mahony",
+    "ekf",
+    "smoother",
+    "rest_gyro_bias",
+    "rts_smoother",
+    "run_vqf",
+    "run_offline_vqf",
+    "run_imufusion",
+    "run_ahrs_madgwick",
+    "run_ahrs_mahony",
+    "run_ahrs_ekf",
+]

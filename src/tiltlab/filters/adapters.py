@@ -1,0 +1,173 @@
+"""Adapters to reference implementations, for comparison: ``vqf`` (VQF and offlineVQF,
+Laidig & Seel 2023), ``imufusion`` (x-io Fusion AHRS) and the pure-Python ``ahrs``
+package (Madgwick, Mahony, EKF).
+
+Each adapter takes the filters' inputs — ``acc`` in m/s², ``gyr`` in rad/s, ``fs`` in
+Hz, optional ``mag`` — and returns (N, 4) scalar-first quaternions sensor → world with
+world z up. The packages are optional (extra ``compare``) and imported on first use.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .. import _validate as _v
+from .. import units as _units
+from ._common import init_samples, initial_orientation, sensor_inputs
+
+__all__ = [
+    "vqf_parameter_names",
+    "run_vqf",
+    "run_offline_vqf",
+    "run_imufusion",
+    "run_ahrs_madgwick",
+    "run_ahrs_mahony",
+    "run_ahrs_ekf",
+]
+
+
+def vqf_parameter_names() -> frozenset[str]:
+    """Names of the ``vqf`` package's own parameters (``tauAcc``, ``restThGyr``, …)."""
+    import vqf
+
+    return frozenset(vqf.VQF(0.01).params)
+
+
+def _vqf(acc, gyr, fs, mag, offline: bool, params: dict) -> np.ndarray:
+    import vqf
+
+    fs = _v.check_fs(fs)
+    a, g, m, use_mag = sensor_inputs(acc, gyr, mag)
+    unknown = sorted(set(params) - vqf_parameter_names())
+    if unknown:
+        raise ValueError(
+            f"unknown vqf parameter(s) {unknown}; "
+            f"valid: {sorted(vqf_parameter_names())}"
+        )
+    m = m if use_mag else None
+    if offline:
+        res = vqf.offlineVQF(g, a, m, 1.0 / fs, dict(params) or None)
+    else:
+        res = vqf.VQF(1.0 / fs, **params).updateBatch(g, a, m)
+    return np.asarray(res["quat9D" if use_mag else "quat6D"])
+
+
+def run_vqf(acc, gyr, fs: float, *, mag=None, **vqf_params) -> np.ndarray:
+    """VQF (``vqf.VQF(...).updateBatch``), 6D or 9D; ``vqf_params`` are the ``vqf``
+    package's own parameters with its own defaults (e.g. ``tauAcc`` in s)."""
+    return _vqf(acc, gyr, fs, mag, False, vqf_params)
+
+
+def run_offline_vqf(acc, gyr, fs: float, *, mag=None, **vqf_params) -> np.ndarray:
+    """offlineVQF (``vqf.offlineVQF``, non-causal), 6D or 9D; ``vqf_params`` as for
+    :func:`run_vqf`."""
+    return _vqf(acc, gyr, fs, mag, True, vqf_params)
+
+
+def run_imufusion(
+    acc,
+    gyr,
+    fs: float,
+    *,
+    gain: float = 0.5,
+    acceleration_rejection_deg: float = 10.0,
+    rejection_timeout_s: float = 5.0,
+) -> np.ndarray:
+    """x-io Fusion AHRS (``imufusion``), 6D, NWU world (z up: tilt comparable).
+
+    ``gyr`` rad/s → °/s and ``acc`` m/s² → g for the package; ``gain`` is Fusion's
+    gain, ``acceleration_rejection_deg`` its acceleration-rejection threshold (°) and
+    ``rejection_timeout_s`` its rejection timeout (s).
+    """
+    import imufusion
+
+    fs = _v.check_fs(fs)
+    acc, gyr, _, _ = sensor_inputs(acc, gyr)
+    gain = _v.nonnegative(gain, "gain")
+    rej = _v.nonnegative(acceleration_rejection_deg, "acceleration_rejection_deg")
+    timeout = _v.nonnegative(rejection_timeout_s, "rejection_timeout_s")
+    settings = imufusion.AhrsSettings(
+        sample_rate=fs,
+        convention=imufusion.CONVENTION_NWU,
+        gain=gain,
+        gyroscope_range=1e6,
+        acceleration_rejection=rej,
+        magnetic_rejection=0.0,
+        rejection_timeout=int(round(timeout * fs)),
+    )
+    a = imufusion.Ahrs()
+    a.set_settings(settings)
+    a.set_sample_period(1.0 / fs)
+    g = np.degrees(gyr)
+    ac = acc / _units.G0
+    out = np.empty((acc.shape[0], 4))
+    for k in range(acc.shape[0]):
+        a.update_no_magnetometer(g[k], ac[k])
+        out[k] = a.get_quaternion()
+    return out
+
+
+def _ahrs_start(acc, gyr, fs, init_window_s):
+    fs = _v.check_fs(fs)
+    acc, gyr, _, _ = sensor_inputs(acc, gyr)
+    q0 = initial_orientation(acc[: init_samples(init_window_s, fs)])
+    return acc, gyr, fs, q0
+
+
+def run_ahrs_madgwick(
+    acc, gyr, fs: float, *, beta: float = 0.05, init_window_s: float = 0.1
+) -> np.ndarray:
+    """``ahrs.filters.Madgwick`` (6D) with an explicit ``frequency``, started at
+    :func:`initial_orientation` of the first ``init_window_s`` seconds."""
+    import ahrs.filters as af
+
+    acc, gyr, fs, q0 = _ahrs_start(acc, gyr, fs, init_window_s)
+    beta = _v.nonnegative(beta, "beta")
+    f = af.Madgwick(gyr=gyr, acc=acc, frequency=fs, gain=beta, q0=q0)
+    return np.asarray(f.Q, float)
+
+
+def run_ahrs_mahony(
+    acc,
+    gyr,
+    fs: float,
+    *,
+    kp: float = 1.0,
+    ki: float = 0.3,
+    init_window_s: float = 0.1,
+) -> np.ndarray:
+    """``ahrs.filters.Mahony`` (6D), started as :func:`run_ahrs_madgwick`.
+
+    ``ahrs`` rejects ``k_I = 0`` (and ``k_P = 0``); the smallest positive float stands
+    in for zero.
+    """
+    import ahrs.filters as af
+
+    acc, gyr, fs, q0 = _ahrs_start(acc, gyr, fs, init_window_s)
+    kp = max(_v.nonnegative(kp, "kp"), 5e-324)
+    ki = max(_v.nonnegative(ki, "ki"), 5e-324)
+    f = af.Mahony(gyr=gyr, acc=acc, frequency=fs, k_P=kp, k_I=ki, q0=q0)
+    return np.asarray(f.Q, float)
+
+
+def run_ahrs_ekf(
+    acc,
+    gyr,
+    fs: float,
+    *,
+    var_gyr: float = 0.3**2,
+    var_acc: float = 0.5**2,
+    init_window_s: float = 0.1,
+) -> np.ndarray:
+    """``ahrs.filters.EKF`` (6D) with ``frame='NED'`` (really z up: ``ahrs``'s
+    ``frame='ENU'`` is upside down), started as :func:`run_ahrs_madgwick`."""
+    import ahrs.filters as af
+
+    acc, gyr, fs, q0 = _ahrs_start(acc, gyr, fs, init_window_s)
+    noises = [
+        _v.nonnegative(var_gyr, "var_gyr"),
+        _v.positive(var_acc, "var_acc"),
+        0.8**2,
+    ]
+    f = af.EKF(gyr=gyr, acc=acc, frequency=fs, frame="NED", q0=q0, noises=noises)
+    return np.asarray(f.Q, float)

@@ -1,0 +1,100 @@
+"""Figure recipes shared by the book's chapters (layer 8; matplotlib, cartopy for maps).
+
+No computation here beyond what a figure needs. Every recipe takes its data first —
+labelled where possible, so that axis labels carry the data's units and times come from
+the ``time`` coordinate — an optional ``ax``, and returns the axes (or the figure for
+multi-panel recipes). Axes are always labelled with units, several lines get a legend and
+maps get a colour bar.
+
+Submodules
+----------
+* :mod:`~tiltlab.plot.recording` — Recordings and named series against time, angular
+  speed traces and histograms;
+* :mod:`~tiltlab.plot.maps` — sphere figures: LAEA maps on a unit globe (cartopy), 3-D
+  facet renderings, time-on-sphere heat maps, visited facets, KDE maps with isopleths,
+  grids of maps, residence maps (formerly :mod:`tiltlab.spheremaps`);
+* :mod:`~tiltlab.plot.scores` — estimator errors: parameter-grid heat maps and curves,
+  per-trial bars, ECDFs, errors binned by speed;
+* :mod:`~tiltlab.plot.cohort` — Tukey boxplots and group means for cohort tables.
+
+Everything is re-exported here: ``from tiltlab import plot; plot.kde_map(k)``.
+"""
+
+from .cohort import group_lines, tukey_boxplot
+from .maps import (
+    SENSOR_AXES,
+    decorate,
+    facet_map,
+    kde_map,
+    laea,
+    lonlat_deg,
+    map_axes,
+    map_grid,
+    plot_facets,
+    plot_grid,
+    plot_isopleths,
+    plot_mask,
+    plot_points,
+    project,
+    residence_figure,
+    sphere_3d,
+    tilt_heatmap,
+    tilt_overview,
+    tilt_points_map,
+    tilt_projection,
+    tilt_trace,
+    unit_globe,
+    visited_map,
+)
+from .recording import (
+    plot_recording,
+    plot_vectors,
+    series_panels,
+    shade_mask,
+    speed_histogram,
+    speed_trace,
+)
+from .scores import binned_errors, ecdf_plot, score_curves, score_heatmap, trial_bars
+
+__all__ = [
+    # recording
+    "plot_recording",
+    "plot_vectors",
+    "shade_mask",
+    "series_panels",
+    "speed_trace",
+    "speed_histogram",
+    # maps
+    "SENSOR_AXES",
+    "unit_globe",
+    "laea",
+    "tilt_projection",
+    "lonlat_deg",
+    "project",
+    "map_axes",
+    "plot_facets",
+    "plot_grid",
+    "plot_isopleths",
+    "plot_mask",
+    "plot_points",
+    "decorate",
+    "sphere_3d",
+    "map_grid",
+    "facet_map",
+    "tilt_heatmap",
+    "tilt_overview",
+    "visited_map",
+    "kde_map",
+    "tilt_points_map",
+    "tilt_trace",
+    "residence_figure",
+    # scores
+    "score_heatmap",
+    "score_curves",
+    "trial_bars",
+    "ecdf_plot",
+    "binned_errors",
+    # cohort
+    "tukey_boxplot",
+    "group_lines",
+]

@@ -1,0 +1,210 @@
+"""Figures of cohort tables: Tukey boxplots by group and time point, group means over time.
+
+Inputs are long tables — one row per session, columns for the grouping variables and
+the features — as a :class:`pandas.DataFrame` or an :class:`xarray.Dataset` (converted
+with ``to_dataframe()``). Units come from ``units=`` or from the Dataset variable's
+``attrs['units']``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+import pandas as pd
+import xarray as xr
+
+from ._common import label, legend_if_many, new_axes
+
+__all__ = ["tukey_boxplot", "group_lines"]
+
+
+def _table(data, value: str) -> tuple[pd.DataFrame, str | None]:
+    units = None
+    if isinstance(data, xr.Dataset):
+        if value in data:
+            units = data[value].attrs.get("units")
+        data = data.to_dataframe().reset_index()
+    elif not isinstance(data, pd.DataFrame):
+        raise TypeError(
+            f"data must be a pandas DataFrame or an xarray Dataset, got {type(data).__name__}"
+        )
+    if value not in data:
+        raise ValueError(f"no column {value!r} in the table")
+    return data, units
+
+
+def _order(df: pd.DataFrame, col: str, order) -> list:
+    if order is not None:
+        return list(order)
+    s = df[col]
+    if isinstance(s.dtype, pd.CategoricalDtype):
+        return list(s.cat.categories)
+    return list(pd.unique(s))
+
+
+def tukey_boxplot(
+    data,
+    value: str,
+    *,
+    by: str,
+    hue: str | None = None,
+    ax=None,
+    units: str | None = None,
+    name: str | None = None,
+    order: Sequence | None = None,
+    hue_order: Sequence | None = None,
+    points: bool = True,
+    seed: int = 0,
+    title: str | None = None,
+):
+    """Tukey boxplots of a feature by category (and sub-category), with the sessions as dots.
+
+    Boxes span the quartiles with the median; whiskers reach the most extreme values
+    within 1.5 IQR of the box (Tukey's rule); values beyond are drawn as outliers.
+
+    Parameters
+    ----------
+    data : pandas.DataFrame or xarray.Dataset
+        Long table, one row per session.
+    value : str
+        Feature column to plot.
+    by : str
+        Column with the categories on the x axis (e.g. ``"time_point"``).
+    hue : str, optional
+        Column with side-by-side boxes within each category (e.g. ``"group"``), with a legend.
+    ax : matplotlib.axes.Axes, optional
+    units : str, optional
+        Units of ``value`` (default the Dataset variable's ``attrs['units']``).
+    name : str, optional
+        y label (default ``value``).
+    order, hue_order : sequence, optional
+        Category orders (default: categorical order, else order of appearance).
+    points : bool
+        Overlay the individual values, jittered.
+    seed : int
+        Seed of the jitter.
+    title : str, optional
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+    """
+    df, u = _table(data, value)
+    units = units if units is not None else u
+    cats = _order(df, by, order)
+    hues = _order(df, hue, hue_order) if hue is not None else [None]
+    ax = new_axes(ax, figsize=(max(4.0, 1.2 * len(cats) * max(1, len(hues))), 3.5))
+    width = 0.8 / len(hues)
+    rng = np.random.default_rng(seed)
+    for k, h in enumerate(hues):
+        sub = df if h is None else df[df[hue] == h]
+        vals = [sub.loc[sub[by] == c, value].dropna().to_numpy(float) for c in cats]
+        pos = np.arange(len(cats)) + (k - (len(hues) - 1) / 2) * width
+        keep = [i for i, v in enumerate(vals) if v.size]
+        colour = f"C{k}"
+        if keep:
+            ax.boxplot(
+                [vals[i] for i in keep],
+                positions=pos[keep],
+                widths=0.85 * width,
+                whis=1.5,
+                patch_artist=True,
+                manage_ticks=False,
+                boxprops={"facecolor": colour, "alpha": 0.35, "edgecolor": colour},
+                medianprops={"color": colour, "lw": 2},
+                whiskerprops={"color": colour},
+                capprops={"color": colour},
+                flierprops={"marker": "x", "markeredgecolor": colour},
+            )
+        if points:
+            for i in keep:
+                jit = rng.uniform(-0.25, 0.25, vals[i].size) * width
+                ax.plot(pos[i] + jit, vals[i], ".", color=colour, ms=4, alpha=0.8)
+        ax.plot(
+            [],
+            [],
+            "s",
+            color=colour,
+            alpha=0.6,
+            label=str(h) if h is not None else value,
+        )
+    ax.set_xticks(np.arange(len(cats)), [str(c) for c in cats])
+    ax.set_xlabel(by)
+    ax.set_ylabel(label(name or value, units))
+    if hue is not None:
+        legend_if_many(ax, title=hue)
+    if title:
+        ax.set_title(title)
+    return ax
+
+
+def group_lines(
+    data,
+    value: str,
+    *,
+    x: str,
+    hue: str,
+    ax=None,
+    units: str | None = None,
+    name: str | None = None,
+    err: str | None = "sem",
+    order: Sequence | None = None,
+    hue_order: Sequence | None = None,
+    title: str | None = None,
+):
+    """Mean of a feature per category of ``x`` (e.g. time points), one line per ``hue`` (group).
+
+    Parameters
+    ----------
+    data : pandas.DataFrame or xarray.Dataset
+        Long table, one row per session.
+    value : str
+        Feature column.
+    x : str
+        Column on the x axis (e.g. ``"time_point"``), in ``order``.
+    hue : str
+        Column with one line per value (e.g. ``"group"``), with a legend.
+    ax : matplotlib.axes.Axes, optional
+    units : str, optional
+    name : str, optional
+        y label (default ``value``).
+    err : {"sem", "sd", None}
+        Error bars: standard error of the mean, standard deviation, or none.
+    order, hue_order : sequence, optional
+    title : str, optional
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+    """
+    if err not in ("sem", "sd", None):
+        raise ValueError(f"err must be 'sem', 'sd' or None, got {err!r}")
+    df, u = _table(data, value)
+    units = units if units is not None else u
+    xs = _order(df, x, order)
+    ax = new_axes(ax, figsize=(4.5, 3.2))
+    for h in _order(df, hue, hue_order):
+        g = df[df[hue] == h].groupby(x, sort=False, observed=True)[value]
+        mean = g.mean().reindex(xs)
+        if err is None:
+            ax.plot(range(len(xs)), mean.to_numpy(float), marker="o", label=str(h))
+        else:
+            spread = g.std(ddof=1).reindex(xs)
+            if err == "sem":
+                spread = spread / np.sqrt(g.count().reindex(xs))
+            ax.errorbar(
+                range(len(xs)),
+                mean.to_numpy(float),
+                yerr=spread.to_numpy(float),
+                marker="o",
+                capsize=2,
+                label=str(h),
+            )
+    ax.set_xticks(range(len(xs)), [str(v) for v in xs], rotation=45)
+    ax.set_xlabel(x)
+    ax.set_ylabel(label(name or value, units))
+    legend_if_many(ax, title=hue, fontsize=7)
+    if title:
+        ax.set_title(title)
+    return ax

@@ -1,0 +1,313 @@
+"""Figures of estimator errors: parameter-grid heat maps and curves, per-trial bars,
+error distributions and errors binned by angular speed.
+
+Inputs are the tables that :mod:`tiltlab.evaluate` and :func:`tiltlab.filters.grid_search`
+return (labelled DataArrays / Datasets, pandas DataFrames). Every recipe takes the data
+first and an optional ``ax``, labels its axes with units and adds a legend when it
+draws several lines.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+
+import numpy as np
+import pandas as pd
+import xarray as xr
+
+from ._common import label, legend_if_many, new_axes, units_of
+
+__all__ = ["score_heatmap", "score_curves", "trial_bars", "ecdf_plot", "binned_errors"]
+
+
+def _fmt(v) -> str:
+    try:
+        return f"{float(v):g}"
+    except (TypeError, ValueError):
+        return str(v)
+
+
+def score_heatmap(
+    scores: xr.DataArray,
+    *,
+    ax=None,
+    log: bool = False,
+    name: str = "mean error",
+    units: str | None = None,
+    mark_best: bool = True,
+    cmap="viridis",
+    title: str | None = None,
+):
+    """Heat map of a score over a two-parameter grid, with the best cell circled and a colour bar.
+
+    Parameters
+    ----------
+    scores : xarray.DataArray
+        Two dimensions (the parameters; e.g. ``grid.sel(shift=0).mean("recording")`` of
+        a :func:`tiltlab.filters.grid_search` result). The first is drawn on y, the
+        second on x; coordinate values label the ticks.
+    ax : matplotlib.axes.Axes, optional
+    log : bool
+        Colour by log10 of the score.
+    name : str
+        What the score is (colour-bar label).
+    units : str, optional
+        Default ``attrs['units']``, else ``"deg"``.
+    mark_best : bool
+        Circle the minimum.
+    cmap : str or Colormap
+    title : str, optional
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+    """
+    if not isinstance(scores, xr.DataArray) or scores.ndim != 2:
+        raise ValueError("scores must be a 2-D DataArray (two parameters)")
+    ax = new_axes(ax, figsize=(4.5, 3.5))
+    a, b = scores.dims
+    v = np.asarray(scores.values, float)
+    shown = np.log10(v) if log else v
+    im = ax.imshow(shown, origin="lower", cmap=cmap, aspect="auto")
+    ax.set_xticks(
+        range(scores.sizes[b]),
+        [_fmt(x) for x in scores[b].values] if b in scores.coords else None,
+    )
+    ax.set_yticks(
+        range(scores.sizes[a]),
+        [_fmt(x) for x in scores[a].values] if a in scores.coords else None,
+    )
+    ax.set_xlabel(b)
+    ax.set_ylabel(a)
+    if mark_best and np.isfinite(v).any():
+        i, j = np.unravel_index(int(np.nanargmin(v)), v.shape)
+        ax.plot(j, i, "o", mfc="none", mec="w", ms=14, mew=2, label="best")
+    u = units or units_of(scores, "deg")
+    ax.figure.colorbar(im, ax=ax, label=label(("log10 " if log else "") + name, u))
+    if title:
+        ax.set_title(title)
+    return ax
+
+
+def score_curves(
+    scores: xr.DataArray,
+    x: str,
+    *,
+    hue: str | None = None,
+    ax=None,
+    logx: bool = True,
+    logy: bool = False,
+    name: str = "mean error",
+    units: str | None = None,
+    title: str | None = None,
+):
+    """A score against one parameter, one line per value of another dimension.
+
+    Parameters
+    ----------
+    scores : xarray.DataArray
+        One dimension ``x``, or two (``x`` and ``hue``), e.g. the mean over recordings of
+        a grid search scored per behavioural state.
+    x : str
+        Parameter dimension on the abscissa.
+    hue : str, optional
+        Dimension with one line per value (default: the other dimension, if any).
+    ax : matplotlib.axes.Axes, optional
+    logx, logy : bool
+    name : str
+        What the score is (y label).
+    units : str, optional
+        Default ``attrs['units']``, else ``"deg"``.
+    title : str, optional
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+    """
+    if x not in scores.dims:
+        raise ValueError(f"{x!r} is not a dimension of scores {scores.dims}")
+    others = [d for d in scores.dims if d != x]
+    if hue is None and others:
+        hue = others[0]
+    if len(others) > (1 if hue is not None else 0):
+        raise ValueError(
+            f"scores must have dims ({x!r}[, hue]); reduce the others first: {scores.dims}"
+        )
+    ax = new_axes(ax, figsize=(5, 3.3))
+    xv = scores[x].values
+    if hue is None:
+        ax.plot(xv, scores.values, "o-", label=scores.name or name)
+    else:
+        for h in scores[hue].values:
+            ax.plot(xv, scores.sel({hue: h}).transpose(x).values, "o-", label=str(h))
+    if logx:
+        ax.set_xscale("log")
+    if logy:
+        ax.set_yscale("log")
+    ax.set_xlabel(label(x, scores[x].attrs.get("units")))
+    ax.set_ylabel(label(name, units or units_of(scores, "deg")))
+    legend_if_many(ax, title=hue)
+    if title:
+        ax.set_title(title)
+    return ax
+
+
+def trial_bars(
+    table,
+    *,
+    ax=None,
+    logy: bool = False,
+    name: str = "RMSE",
+    units: str | None = None,
+    legend_title: str = "estimator",
+    title: str | None = None,
+    figsize=(11, 5),
+):
+    """Grouped bars: one group per trial, one bar per estimator (or any column).
+
+    Parameters
+    ----------
+    table : pandas.DataFrame or xarray.DataArray
+        Rows = trials, columns = estimators (a 2-D DataArray is converted with
+        ``to_pandas()``; its ``units`` label the axis).
+    ax : matplotlib.axes.Axes, optional
+    logy : bool
+    name : str
+        What the values are (y label).
+    units : str, optional
+        Default ``attrs['units']`` (DataFrame: ``df.attrs['units']``), else ``"deg"``.
+    legend_title : str
+    title : str, optional
+    figsize : (float, float)
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+    """
+    u = (
+        units
+        or units_of(table)
+        or (table.attrs.get("units") if isinstance(table, pd.DataFrame) else None)
+        or "deg"
+    )
+    df = table.to_pandas() if isinstance(table, xr.DataArray) else pd.DataFrame(table)
+    ax = new_axes(ax, figsize=figsize)
+    df.plot.bar(ax=ax, width=0.8, logy=logy)
+    ax.set_ylabel(label(name + (", log scale" if logy else ""), u))
+    ax.set_xlabel(df.index.name or "trial")
+    ax.legend(
+        title=legend_title,
+        loc="upper left",
+        bbox_to_anchor=(1.005, 1.0),
+        frameon=False,
+        fontsize=8,
+    )
+    if title:
+        ax.set_title(title)
+    return ax
+
+
+def ecdf_plot(
+    errors: Mapping[str, object],
+    *,
+    mask=None,
+    ax=None,
+    logx: bool = True,
+    name: str = "tilt error",
+    units: str | None = None,
+    vline: float | None = None,
+    vline_label: str | None = None,
+    title: str | None = None,
+):
+    """Empirical cumulative distributions of per-sample errors, one line per estimator.
+
+    Parameters
+    ----------
+    errors : mapping str → array_like or xarray.DataArray
+        Per-sample errors (NaN ignored).
+    mask : array_like of bool, optional
+        Samples to keep (e.g. immobility).
+    ax : matplotlib.axes.Axes, optional
+    logx : bool
+    name : str
+        What the errors are (x label).
+    units : str, optional
+        Default the first series' ``attrs['units']``, else ``"deg"``.
+    vline : float, optional
+        A reference value (e.g. the optical reference's uncertainty), drawn dashed.
+    vline_label : str, optional
+    title : str, optional
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+    """
+    ax = new_axes(ax, figsize=(5, 3.5))
+    for k, (m, e) in enumerate(errors.items()):
+        v = np.asarray(e, float).ravel()
+        if mask is not None:
+            v = v[np.asarray(mask, bool).ravel()]
+        v = np.sort(v[np.isfinite(v)])
+        ax.plot(v, np.arange(1, v.size + 1) / max(v.size, 1), label=m)
+    if vline is not None:
+        ax.axvline(vline, ls="--", c="purple", label=vline_label or f"{vline:.2g}")
+    if logx:
+        ax.set_xscale("log")
+    ax.set_xlabel(label(name, units or units_of(next(iter(errors.values())), "deg")))
+    ax.set_ylabel("cumulative fraction")
+    legend_if_many(ax, fontsize=7)
+    if title:
+        ax.set_title(title)
+    return ax
+
+
+def binned_errors(
+    bins: xr.Dataset,
+    *,
+    ax=None,
+    logy: bool = True,
+    name: str = "median error",
+    units: str = "deg",
+    xname: str = "angular speed",
+    xunits: str = "deg/s",
+    title: str | None = None,
+):
+    """Median and interquartile range of errors per speed bin, one line per estimator (Fayat Fig. 2f).
+
+    Parameters
+    ----------
+    bins : xarray.Dataset
+        From :func:`tiltlab.evaluate.binned_by_speed`: ``median``, ``q25``, ``q75`` with
+        dims (estimator, speed).
+    ax : matplotlib.axes.Axes, optional
+    logy : bool
+    name, units : str
+        y label and units.
+    xname, xunits : str
+        x label and units (the bin centres).
+    title : str, optional
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+    """
+    ax = new_axes(ax, figsize=(5, 3.5))
+    xdim = [d for d in bins["median"].dims if d != "estimator"][0]
+    for m in bins["estimator"].values:
+        b = bins.sel(estimator=m)
+        med = b["median"].values
+        ax.errorbar(
+            b[xdim].values,
+            med,
+            yerr=[med - b["q25"].values, b["q75"].values - med],
+            label=str(m),
+            capsize=2,
+        )
+    if logy:
+        ax.set_yscale("log")
+    ax.set_xlabel(label(xname, xunits))
+    ax.set_ylabel(label(name, units))
+    legend_if_many(ax, fontsize=7)
+    if title:
+        ax.set_title(title)
+    return ax

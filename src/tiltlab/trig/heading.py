@@ -1,0 +1,184 @@
+r"""Heading: azimuth from acceleration and magnetic field (Benhamou 2023 §3, Eqs. 5, 18,
+App. A).
+
+:func:`azimuth`, :func:`collar_azimuth` and :func:`heading` take ``acc`` and ``mag`` as
+Recordings, labelled DataArrays or plain arrays (..., 3); pass a Recording alone
+(``heading(rec)``) to read both its ``acc`` and its ``mag``. Labelled input gives
+labelled output. Magnetometer calibration (Eq. 4) lives in
+:mod:`tiltlab.calibration` (:func:`~tiltlab.calibration.four_point_mag_calibration`,
+:func:`~tiltlab.calibration.apply_mag_calibration`).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .. import _validate as _v
+from ..frames import (
+    R1,
+    R2,
+    Convention,
+    Orientation,
+    _as_benhamou,
+    _elev_bank,
+    unit_vector,
+    wrap_angle,
+)
+from ._common import first_labelled, label, pair, read
+
+__all__ = [
+    "mounting_azimuth_offset",
+    "azimuth",
+    "collar_azimuth",
+    "heading",
+    "body_azimuth_from_device",
+    "apply_declination",
+]
+
+
+def _declination(declination) -> np.ndarray:
+    return _v.vectors(declination, "declination", width=None, ndim=None)
+
+
+def _azimuth(A, M, declination, singular_tol: float) -> np.ndarray:
+    """Eq. 5 on arrays (A in Benhamou's sign)."""
+    A, M = np.broadcast_arrays(A, M)
+    AU, AV, AW = A[..., 0], A[..., 1], A[..., 2]
+    MU, MV, MW = M[..., 0], M[..., 1], M[..., 2]
+    s2 = AV**2 + AW**2
+    n = np.sqrt(AU**2 + s2)
+    th = np.arctan2(s2 * MU - AU * (AV * MV + AW * MW), (AV * MW - AW * MV) * n)
+    sing = np.sqrt(s2) < singular_tol * n
+    sg = np.where(AU >= 0, 1.0, -1.0)
+    pseudo = np.arctan2(MV, -sg * MW) - np.pi / 2
+    th = np.where(sing, pseudo, th)
+    return wrap_angle(th - declination)
+
+
+def _read_pair(acc, mag):
+    sa = read(acc, "acc")
+    sm = read(pair(acc, mag), "mag")
+    return sa, sm
+
+
+def mounting_azimuth_offset(
+    acc_rest, mag_rest, observed_bearing, *, convention: Convention = "tiltlab"
+) -> np.ndarray:
+    r"""App. A azimuth mismatch :math:`\theta^* - \pi/2 + \theta^{obs}` (rad).
+
+    θ* is the device azimuth at rest (Eq. 5 on the device vectors, ccw from East)
+    and ``observed_bearing`` the visually assessed body bearing θ^obs (clockwise from
+    North, radians, as read on a compass). Pass the result as ``dtheta`` to
+    :func:`~tiltlab.frames.mounting_matrix` / :func:`~tiltlab.frames.device_to_body`.
+    """
+    theta_star = azimuth(acc_rest, mag_rest, convention=convention)
+    bearing = _v.vectors(observed_bearing, "observed_bearing", width=None, ndim=None)
+    return wrap_angle(np.asarray(theta_star) - np.pi / 2 + bearing)
+
+
+def azimuth(
+    acc,
+    mag=None,
+    *,
+    convention: Convention = "tiltlab",
+    declination=0.0,
+    singular_tol: float = 1e-9,
+) -> np.ndarray:
+    r"""Body azimuth θ (ccw from East, rad) from body-frame static acceleration and
+    magnetic field, Eq. 5.
+
+    .. math::
+        \theta = \mathrm{atan2}\big((A_V^2+A_W^2)M_U - A_U(A_V M_V + A_W M_W),\;
+        (A_V M_W - A_W M_V)\|\mathbf A\|\big)
+
+    (𝐀 in Benhamou's sign; the second argument changes sign with the convention,
+    which is why ``convention`` matters). This is atan2 of the levelled field
+    :math:`\underline M_U, \underline M_V`,
+    :math:`\underline{\mathbf M}^\top=R_2(\phi)R_1(\lambda)\mathbf M^\top`.
+
+    With magnetic vectors the result is magnetic azimuth; ``declination`` (rad,
+    positive East) is subtracted to get the true azimuth (:func:`apply_declination`).
+
+    Singular case (φ ≈ ±π/2, :math:`(A_V^2+A_W^2)^{1/2} <` ``singular_tol``·‖𝐀‖):
+    the pseudo-azimuth θ = θ' − π/2 with θ' = atan2(M_V, −sgn(A_U) M_W), the
+    direction of the sway axis (§3), consistent with pseudo-bank λ = 0.
+
+    Parameters
+    ----------
+    acc : xarray.Dataset, xarray.DataArray or array_like (..., 3)
+        Static acceleration (a Recording: its ``acc``, and its ``mag`` if ``mag`` is
+        None).
+    mag : xarray.DataArray or array_like (..., 3), optional
+        Calibrated magnetic field in the same frame (any unit).
+    """
+    singular_tol = _v.positive(singular_tol, "singular_tol")
+    decl = _declination(declination)
+    sa, sm = _read_pair(acc, mag)
+    th = _azimuth(_as_benhamou(sa.values, convention), sm.values, decl, singular_tol)
+    return label(th, first_labelled(sa, sm), "azimuth", "rad")
+
+
+def collar_azimuth(
+    acc, mag=None, *, convention: Convention = "tiltlab", declination=0.0
+) -> np.ndarray:
+    r"""Eq. 18: azimuth of a collar-mounted device from *device* static acceleration
+    and mean field.
+
+    Same expression as Eq. 5 applied to :math:`\bar{\mathbf a}, \bar{\mathbf m}`
+    (device frame): valid for the body when the animal moves unbanked and the device
+    surge axis is orthogonal to the collar plane, whatever the collar roll.
+    """
+    return azimuth(acc, mag, convention=convention, declination=declination)
+
+
+def heading(
+    acc,
+    mag=None,
+    *,
+    convention: Convention = "tiltlab",
+    declination=0.0,
+    singular_tol: float = 1e-9,
+) -> Orientation:
+    """Full 3-D orientation (θ Eq. 5, φ Eq. 3a, λ Eq. 3b) with the §3 fallback
+    (pseudo-bank 0) at φ = ±π/2.
+
+    Inputs as for :func:`azimuth` (``heading(rec)`` reads a Recording's ``acc`` and
+    ``mag``). Returns an :class:`~tiltlab.frames.Orientation` in radians (DataArrays
+    for labelled input).
+    """
+    singular_tol = _v.positive(singular_tol, "singular_tol")
+    decl = _declination(declination)
+    sa, sm = _read_pair(acc, mag)
+    A = _as_benhamou(sa.values, convention)
+    th = _azimuth(A, sm.values, decl, singular_tol)
+    el, bk = _elev_bank(A)
+    sing = np.hypot(A[..., 1], A[..., 2]) < singular_tol * np.linalg.norm(A, axis=-1)
+    el = np.where(sing, np.where(A[..., 0] >= 0, -np.pi / 2, np.pi / 2), el)
+    bk = np.where(sing, 0.0, bk)
+    like = first_labelled(sa, sm)
+    return Orientation(
+        label(th, like, "azimuth", "rad"),
+        label(el, like, "elevation", "rad"),
+        label(bk, like, "bank", "rad"),
+    )
+
+
+def body_azimuth_from_device(device_azimuth, elevation, bank, phi_star) -> np.ndarray:
+    r"""§3 alternative to Eq. 5: :math:`\theta=\theta^d-\mathrm{atan2}(c_2,c_1)`,
+    :math:`(c_1,c_2,c_3)^\top=R_2(\phi)R_1(\lambda)[0\bullet\phi^*]^\top`.
+
+    θ^d is the device azimuth (Eq. 18 on device vectors), φ, λ the body posture and
+    φ* the longitudinal mounting tilt (device surge axis in the sagittal plane).
+    """
+    c = np.einsum(
+        "...ij,...j->...i", R2(elevation) @ R1(bank), unit_vector(0.0, phi_star)
+    )
+    return wrap_angle(
+        np.asarray(device_azimuth, float) - np.arctan2(c[..., 1], c[..., 0])
+    )
+
+
+def apply_declination(magnetic_azimuth, declination) -> np.ndarray:
+    """True azimuth = magnetic azimuth − declination (rad, declination positive East),
+    wrapped to (−π, π]."""
+    return wrap_angle(np.asarray(magnetic_azimuth, float) - _declination(declination))

@@ -1,0 +1,152 @@
+r"""Posture from static acceleration and from the magnetic field (Benhamou 2023 §2–§3).
+
+Every function taking an acceleration accepts a Recording (variable ``acc``), a
+labelled DataArray or a plain array (shape (..., 3)); labelled input gives labelled
+output. Units do not matter (only directions do).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .. import _validate as _v
+from ..frames import Convention, _as_benhamou, _clip1, _elev_bank, acc_from_angles
+from ._common import label, read
+from ._types import Posture
+
+__all__ = [
+    "posture",
+    "inclination_from_angles",
+    "angles_from_inclination",
+    "correct_tangential",
+    "correct_centripetal",
+    "magnetic_posture",
+    "posture_from_magnetic_loop",
+]
+
+
+def posture(acc, *, convention: Convention = "tiltlab") -> Posture:
+    r"""Body posture from (static, body-frame) acceleration, Eqs. 2–3.
+
+    .. math::
+        \phi &= \sin^{-1}(-A_U/\|\mathbf A\|)
+               = \tan^{-1}\!\big(-A_U/(A_V^2+A_W^2)^{1/2}\big) \quad(3a)\\
+        \lambda &= \mathrm{atan2}(-A_V, -A_W) \quad(3b)\\
+        \zeta &= \cos^{-1}(-A_W/\|\mathbf A\|) \quad(2a)\\
+        \chi &= \mathrm{atan2}(-A_V, -A_U) \quad(2b)
+
+    with Benhamou's sign 𝐀 (−𝐟 for tiltlab specific force). φ is evaluated in its
+    atan form and ζ as atan2 (accurate near 0 and ±π/2). Singular cases: λ is
+    undefined at φ = ±π/2 (returned as atan2(0, 0) = 0, the pseudo-bank of §3); χ is
+    undefined at ζ = 0 (returned as 0).
+
+    Parameters
+    ----------
+    acc : xarray.Dataset, xarray.DataArray or array_like (..., 3)
+        Static acceleration in the body frame (a Recording: its ``acc``). Low-pass it
+        first (:func:`tiltlab.behavior.static_acceleration`) for a moving animal.
+    convention : {"tiltlab", "benhamou"}
+        Sign of ``acc``: specific force (tiltlab) or gravity (Benhamou).
+
+    Returns
+    -------
+    Posture
+        Angles in radians (DataArrays with ``time``/``fs`` for labelled input).
+    """
+    s = read(acc, "acc")
+    A = _as_benhamou(s.values, convention)
+    el, bk = _elev_bank(A)
+    zeta = np.arctan2(np.hypot(A[..., 0], A[..., 1]), -A[..., 2])
+    chi = np.arctan2(-A[..., 1], -A[..., 0])
+    return Posture(
+        label(el, s, "elevation", "rad"),
+        label(bk, s, "bank", "rad"),
+        label(zeta, s, "inclination", "rad"),
+        label(chi, s, "orientation", "rad"),
+    )
+
+
+def inclination_from_angles(elevation, bank) -> tuple[np.ndarray, np.ndarray]:
+    r"""(ζ, χ) from (φ, λ):
+    :math:`[\chi\bullet(\pi/2-\zeta)] = (\sin\phi, \cos\phi\sin\lambda,
+    \cos\phi\cos\lambda)`.
+
+    In particular :math:`\cos\zeta=\cos\phi\cos\lambda`.
+    """
+    v = acc_from_angles(elevation, bank)
+    zeta = np.arctan2(np.hypot(v[..., 0], v[..., 1]), v[..., 2])
+    return zeta, np.arctan2(v[..., 1], v[..., 0])
+
+
+def angles_from_inclination(inclination, orientation) -> tuple[np.ndarray, np.ndarray]:
+    r"""(φ, λ) from (ζ, χ): :math:`\phi=\sin^{-1}(\sin\zeta\cos\chi)`,
+    :math:`\lambda=\mathrm{atan2}(\sin\zeta\sin\chi,\cos\zeta)`."""
+    z, c = np.broadcast_arrays(
+        np.asarray(inclination, float), np.asarray(orientation, float)
+    )
+    elevation = np.arcsin(_clip1(np.sin(z) * np.cos(c)))
+    return elevation, np.arctan2(np.sin(z) * np.sin(c), np.cos(z))
+
+
+def correct_tangential(elevation, tangential_acc, *, g: float = 9.81) -> np.ndarray:
+    r"""Elevation corrected for a sustained forward acceleration h = Δv/Δt (§2):
+    :math:`\phi - \tan^{-1}(h/g)`.
+
+    ``tangential_acc`` and ``g`` in the same units; h < 0 for a deceleration.
+    """
+    g = _v.positive(g, "g")
+    return np.asarray(elevation, float) - np.arctan2(
+        np.asarray(tangential_acc, float), g
+    )
+
+
+def correct_centripetal(bank, speed, curvature, *, g: float = 9.81) -> np.ndarray:
+    r"""Bank corrected for a sustained horizontal turn (§2):
+    :math:`\lambda - \tan^{-1}(v^2\kappa/g)`.
+
+    ``curvature`` κ = 1/r is signed, positive for a left (counter-clockwise) turn,
+    which reproduces Benhamou's "− for a left turn, + for a right turn". κ = 0 is a
+    straight path (no NaN). ``speed`` and ``g`` in consistent units (m/s, m/s²).
+    """
+    g = _v.positive(g, "g")
+    v = np.asarray(speed, float)
+    return np.asarray(bank, float) - np.arctan2(v**2 * np.asarray(curvature, float), g)
+
+
+def magnetic_posture(mag) -> tuple[np.ndarray, np.ndarray]:
+    r"""Magnetic 'elevation' and 'bank' :math:`\sin^{-1}(-M_U/\|\mathbf M\|)`,
+    :math:`\mathrm{atan2}(-M_V,-M_W)` (§3).
+
+    Insensitive to dynamic acceleration, but measured against the plane orthogonal
+    to the (dipping) field, hence hard to interpret on its own. ``mag``: a Recording
+    (its ``mag``), a labelled DataArray or an array (..., 3).
+    """
+    s = read(mag, "mag")
+    el, bk = _elev_bank(s.values)
+    return label(el, s, "magnetic_elevation", "rad"), label(
+        bk, s, "magnetic_bank", "rad"
+    )
+
+
+def posture_from_magnetic_loop(
+    mag_loop, inclination: float
+) -> tuple[float, float, float]:
+    r"""Posture of a bird looping in a thermal from magnetic vectors sampled evenly
+    over one loop (§3).
+
+    With :math:`\Sigma\mathbf M` the sum of the body-frame field vectors and I the
+    geomagnetic dip (rad, positive downward):
+    :math:`\zeta=\cos^{-1}(|\Sigma M_W|/\|\Sigma\mathbf M\|)`,
+    :math:`\phi=\sin^{-1}(-\mathrm{sgn}(I)\Sigma M_U/\|\Sigma\mathbf M\|)`,
+    :math:`\lambda=\tan^{-1}(-\mathrm{sgn}(I)\Sigma M_V/|\Sigma M_W|)`.
+    Returns (ζ, φ, λ); valid for |λ| < π/2.
+    """
+    inclination = _v.finite(inclination, "inclination")
+    m = read(mag_loop, "mag_loop", var="mag", allow_nan=False).values
+    s = m.reshape(-1, 3).sum(axis=0)
+    n = np.linalg.norm(s)
+    sg = np.sign(inclination) if inclination != 0 else 1.0
+    zeta = float(np.arctan2(np.hypot(s[0], s[1]), abs(s[2])))
+    phi = float(np.arcsin(np.clip(-sg * s[0] / n, -1, 1)))
+    lam = float(np.arctan2(-sg * s[1], abs(s[2])))
+    return zeta, phi, lam
