@@ -43,7 +43,9 @@ def check_immobility(nb_path: Path, params: dict) -> str:
 
     rec = datasets.load(params["SOURCE"])
     expected = float(
-        behavior.immobility(rec, threshold_deg_s=params["IMMOBILE_DEG_S"]).mean()
+        behavior.immobility(
+            rec, threshold_deg_s=params["IMMOBILE_DEG_S"], gyr_offset="auto"
+        ).mean()
     )
     found = _printed(nb_path, r"immobile ([0-9.]+)% of the time")
     if not found:

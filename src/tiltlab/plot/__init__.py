@@ -21,30 +21,32 @@ Everything is re-exported here: ``from tiltlab import plot; plot.kde_map(k)``.
 """
 
 from .cohort import group_lines, tukey_boxplot
+from .mapfigures import (
+    facet_map,
+    kde_map,
+    map_grid,
+    residence_figure,
+    tilt_heatmap,
+    tilt_overview,
+    tilt_points_map,
+    tilt_trace,
+    visited_map,
+)
 from .maps import (
     SENSOR_AXES,
     decorate,
-    facet_map,
-    kde_map,
     laea,
     lonlat_deg,
     map_axes,
-    map_grid,
     plot_facets,
     plot_grid,
     plot_isopleths,
     plot_mask,
     plot_points,
     project,
-    residence_figure,
     sphere_3d,
-    tilt_heatmap,
-    tilt_overview,
-    tilt_points_map,
     tilt_projection,
-    tilt_trace,
     unit_globe,
-    visited_map,
 )
 from .recording import (
     plot_recording,

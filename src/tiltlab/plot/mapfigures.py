@@ -1,0 +1,704 @@
+"""Sphere figure recipes: heat maps of time on the sphere, visited facets, KDE maps with
+isopleths, grids of maps and residence maps, built on the LAEA primitives of
+:mod:`tiltlab.plot.maps`. Each takes its data first (labelled where possible), an optional
+``ax``, and adds colour bars and units.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+
+import matplotlib.pyplot as plt
+import numpy as np
+import xarray as xr
+
+from .. import sphere as S
+from ._common import label, legend_if_many, units_of
+from .maps import (
+    tilt_projection,
+    project,
+    map_axes,
+    plot_facets,
+    plot_mask,
+    plot_grid,
+    plot_isopleths,
+    plot_points,
+    decorate,
+    sphere_3d,
+)
+
+__all__ = [
+    "map_grid",
+    "facet_map",
+    "tilt_heatmap",
+    "tilt_overview",
+    "visited_map",
+    "kde_map",
+    "tilt_points_map",
+    "tilt_trace",
+    "residence_figure",
+]
+
+# ---------------------------------------------------------------------------
+# figure recipes
+# ---------------------------------------------------------------------------
+
+
+def _map_ax(ax, centre=(0.0, 0.0, 1.0), figsize=(5, 5)):
+    if ax is None:
+        fig = plt.figure(figsize=figsize)
+        return map_axes(fig, 111, centre=centre)
+    if not hasattr(ax, "projection"):
+        raise ValueError(
+            "ax must be a map axes (tiltlab.plot.map_axes or map_grid), got a plain Axes"
+        )
+    return ax
+
+
+def _colorbar(ax, mappable, text: str, **kw):
+    kw.setdefault("shrink", 0.7)
+    return ax.figure.colorbar(mappable, ax=ax, label=text, **kw)
+
+
+def _is_map(data) -> bool:
+    return isinstance(data, xr.Dataset) and "count" in data and "facet" in data.dims
+
+
+def _mesh_of(tmap: xr.Dataset, mesh):
+    if mesh is not None:
+        return mesh
+    return S.sphere_mesh(int(tmap.attrs.get("n_vertices", 5000)))
+
+
+def _as_map(data, mesh):
+    """A tilt map from a tilt-map Dataset or from tilt vectors (labelled or plain)."""
+    if _is_map(data):
+        return data, _mesh_of(data, mesh)
+    mesh = S.sphere_mesh() if mesh is None else mesh
+    return S.tilt_map(data, mesh=mesh), mesh
+
+
+def map_grid(
+    n: int,
+    *,
+    ncols: int | None = None,
+    centre=(0.0, 0.0, 1.0),
+    panel_size: float = 4.6,
+    figsize: tuple[float, float] | None = None,
+    **kw,
+):
+    """A figure with ``n`` LAEA map axes in a grid.
+
+    Parameters
+    ----------
+    n : int
+        Number of maps.
+    ncols : int, optional
+        Maps per row (default ``n`` up to 3).
+    centre : array_like (3,) or sequence of them
+        Map centre (direction), one for all or one per map.
+    panel_size : float
+        Width and height (inches) of one map when ``figsize`` is not given.
+    figsize : (float, float), optional
+    **kw
+        Passed to :func:`laea` (``nose_up``).
+
+    Returns
+    -------
+    fig : matplotlib.figure.Figure
+    axes : list of cartopy GeoAxes
+    """
+    n = int(n)
+    if n < 1:
+        raise ValueError(f"n must be at least 1, got {n!r}")
+    ncols = min(n, 3) if ncols is None else int(ncols)
+    nrows = -(-n // ncols)
+    fig = plt.figure(figsize=figsize or (panel_size * ncols, panel_size * nrows))
+    c = np.asarray(centre, float)
+    centres = [c] * n if c.ndim == 1 else list(c)
+    if len(centres) != n:
+        raise ValueError(f"centre must be one direction or {n} of them")
+    axes = [
+        map_axes(fig, (nrows, ncols, k + 1), centre=centres[k], **kw) for k in range(n)
+    ]
+    return fig, axes
+
+
+def facet_map(
+    values,
+    mesh: S.SphereMesh | None = None,
+    *,
+    ax=None,
+    name: str | None = None,
+    units: str | None = None,
+    log: bool = False,
+    cmap="viridis",
+    colorbar: bool = True,
+    decorate_kw: dict | None = None,
+    title: str | None = None,
+    **kw,
+):
+    """Colour the facets of a triangulated sphere on a LAEA map, with gridlines and a colour bar.
+
+    Parameters
+    ----------
+    values : array_like or xarray.DataArray, shape (F,)
+        A value per facet (NaN facets stay blank); a DataArray gives ``long_name`` and
+        ``units`` for the colour-bar label.
+    mesh : SphereMesh, optional
+        Default the 5000-vertex Fibonacci mesh.
+    ax : GeoAxes, optional
+        A map axes (:func:`map_axes`, :func:`map_grid`); default a new figure centred on +z.
+    name, units : str, optional
+        Colour-bar label and units (default from the DataArray, else ``"value"``).
+    log : bool
+        Colour by log10 of the values (non-positive values are left blank).
+    cmap : str or Colormap
+    colorbar : bool
+    decorate_kw : dict, optional
+        Passed to :func:`decorate`.
+    title : str, optional
+    **kw
+        Passed to :func:`plot_facets`.
+
+    Returns
+    -------
+    GeoAxes
+    """
+    ax = _map_ax(ax)
+    name = (
+        name
+        or (values.attrs.get("long_name") if isinstance(values, xr.DataArray) else None)
+        or "value"
+    )
+    units = units if units is not None else units_of(values)
+    v = np.asarray(values, float)
+    if log:
+        with np.errstate(divide="ignore", invalid="ignore"):
+            v = np.where(v > 0, np.log10(v), np.nan)
+        name = f"log10 {name}"
+    art = plot_facets(ax, v, mesh, cmap=cmap, **kw)
+    decorate(ax, **(decorate_kw or {}))
+    if colorbar:
+        _colorbar(ax, art, label(name, units))
+    if title:
+        ax.set_title(title, fontsize=9)
+    return ax
+
+
+def tilt_heatmap(
+    tilt,
+    *,
+    mesh: S.SphereMesh | None = None,
+    quantity: str = "fraction",
+    log: bool = True,
+    ax=None,
+    cmap="magma",
+    title: str | None = None,
+    **kw,
+):
+    """Heat map of the time spent on each facet of the sphere (Fayat et al. Fig. 3a–b).
+
+    Parameters
+    ----------
+    tilt : xarray.Dataset, xarray.DataArray or array_like
+        A tilt map (:func:`tiltlab.sphere.tilt_map`) or tilt vectors to map (a labelled
+        (time, axis) series with ``fs``, a Recording with ``gravity``, or an (N, 3) array).
+    mesh : SphereMesh, optional
+        The map's mesh (default the mesh with the map's ``n_vertices``, or 5000 vertices).
+    quantity : {"fraction", "time", "count", "density"}
+        Variable of the map to colour (``time`` needs a known sampling rate).
+    log : bool
+        Colour by log10 (facets never visited stay blank either way).
+    ax : GeoAxes, optional
+    cmap : str or Colormap
+    title : str, optional
+    **kw
+        Passed to :func:`facet_map`.
+
+    Returns
+    -------
+    GeoAxes
+    """
+    tmap, mesh = _as_map(tilt, mesh)
+    if quantity not in ("fraction", "time", "count", "density"):
+        raise ValueError(
+            f"quantity must be 'fraction', 'time', 'count' or 'density', got {quantity!r}"
+        )
+    if quantity not in tmap:
+        raise ValueError(
+            f"the map has no {quantity!r} (the sampling rate fs is unknown); use quantity='fraction'"
+        )
+    da = tmap[quantity].where(tmap["count"] > 0)
+    return facet_map(
+        da,
+        mesh,
+        ax=ax,
+        name=da.attrs.get("long_name", quantity),
+        units=da.attrs.get("units"),
+        log=log,
+        cmap=cmap,
+        title=title,
+        **kw,
+    )
+
+
+def tilt_overview(
+    tilt,
+    *,
+    mesh: S.SphereMesh | None = None,
+    quantity: str = "fraction",
+    log: bool = True,
+    cmap="magma",
+    traj_kw: dict | None = None,
+    figsize=(11, 4.6),
+):
+    """A 3-D sphere with the trajectory beside the LAEA heat map of the same tilt map.
+
+    Parameters
+    ----------
+    tilt : xarray.DataArray, xarray.Dataset or array_like
+        Tilt vectors (labelled (time, axis) with ``fs``, a Recording with ``gravity``, or (N, 3)).
+    mesh : SphereMesh, optional
+    quantity, log, cmap
+        As in :func:`tilt_heatmap`.
+    traj_kw : dict, optional
+        Style of the trajectory on the 3-D sphere.
+    figsize : (float, float)
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        Panels (a) 3-D sphere and trajectory, (b) LAEA map centred on +z with a colour bar.
+    """
+    mesh = S.sphere_mesh() if mesh is None else mesh
+    tmap = S.tilt_map(tilt, mesh=mesh)
+    if quantity not in tmap:
+        raise ValueError(
+            f"the map has no {quantity!r} (the sampling rate fs is unknown or quantity "
+            "is not one of 'fraction', 'time', 'count', 'density')"
+        )
+    g = S.as_unit_vectors(tilt, "tilt", allow_nan=True)
+    fig = plt.figure(figsize=figsize)
+    ax3 = fig.add_subplot(121, projection="3d")
+    v = tmap[quantity].where(tmap["count"] > 0).values
+    with np.errstate(divide="ignore", invalid="ignore"):
+        v3 = np.log10(v) if log else v
+    sm = sphere_3d(
+        ax3,
+        v3,
+        mesh,
+        cmap=cmap,
+        trajectory=g,
+        traj_kw={"color": "c", "lw": 0.4, "alpha": 0.6} | (traj_kw or {}),
+    )
+    name = ("log10 " if log else "") + tmap[quantity].attrs.get("long_name", quantity)
+    ax3.set_title(f"(a) {name} per facet and trajectory", fontsize=9)
+    ax = map_axes(fig, 122)
+    tilt_heatmap(
+        tmap,
+        mesh=mesh,
+        quantity=quantity,
+        log=log,
+        ax=ax,
+        cmap=cmap,
+        norm=sm.norm,
+        title="(b) LAEA map centred on +z",
+    )
+    return fig
+
+
+def visited_map(
+    series: Mapping[str, object],
+    *,
+    mesh: S.SphereMesh | None = None,
+    colors=None,
+    alpha: float = 0.75,
+    ax=None,
+    min_count: int = 1,
+    legend: bool = True,
+    decorate_kw: dict | None = None,
+    title: str | None = None,
+):
+    """Binarised maps (facets visited at least ``min_count`` times) of several series, overlaid.
+
+    Parameters
+    ----------
+    series : mapping str → tilt vectors or tilt map
+        E.g. ``{"active": g[~immobile], "immobile": g[immobile]}``; later entries are drawn
+        on top.
+    mesh : SphereMesh, optional
+    colors : sequence of colours, optional
+        One per series (default green, red, blue...).
+    alpha : float
+    ax : GeoAxes, optional
+    min_count : int
+    legend : bool
+    decorate_kw : dict, optional
+    title : str, optional
+
+    Returns
+    -------
+    GeoAxes
+    """
+    from matplotlib.patches import Patch
+
+    ax = _map_ax(ax)
+    colors = (
+        list(colors)
+        if colors is not None
+        else ["tab:green", "tab:red", "tab:blue", "tab:orange", "tab:purple"]
+    )
+    handles = []
+    for k, (name, data) in enumerate(series.items()):
+        tmap, m = _as_map(data, mesh)
+        c = colors[k % len(colors)]
+        plot_mask(ax, S.visited(tmap, min_count=min_count), m, color=c, alpha=alpha)
+        frac = S.visited_fraction(tmap, m, min_count=min_count)
+        handles.append(
+            Patch(
+                color=c, alpha=alpha, label=f"{name} ({100 * frac:.1f} % of the sphere)"
+            )
+        )
+    decorate(ax, **({"fontsize": 7} | (decorate_kw or {})))
+    if legend:
+        ax.legend(
+            handles=handles,
+            loc="upper center",
+            bbox_to_anchor=(0.5, -0.02),
+            fontsize=8,
+            frameon=False,
+        )
+    if title:
+        ax.set_title(title, fontsize=9)
+    return ax
+
+
+def kde_map(
+    kde: S.SphericalKDE,
+    *,
+    levels=(0.5, 0.95),
+    scale: str = "sqrt",
+    cut: float | None = None,
+    points=None,
+    centre=(0.0, 0.0, 1.0),
+    extent: float | None = None,
+    ax=None,
+    cmap="viridis",
+    iso_color="w",
+    colorbar: bool = True,
+    labels: dict | None = None,
+    grid_step_deg: float | None = None,
+    point_kw: dict | None = None,
+    title: str | None = None,
+):
+    """A spherical KDE on a LAEA map with its cumulative isopleths (Benhamou Fig. 5).
+
+    Parameters
+    ----------
+    kde : tiltlab.sphere.SphericalKDE
+        From :func:`tiltlab.sphere.kde` or :func:`tiltlab.sphere.mkde`.
+    levels : sequence of float
+        Isopleths to draw (fractions of the distribution), each with its line style and
+        a legend entry.
+    scale : {"sqrt", "linear", "log"}
+        Colour scale of the density.
+    cut : float, optional
+        Show the density only inside this isopleth (e.g. 0.95).
+    points : array_like (N, 3) or labelled tilt, optional
+        Samples to overlay as dots.
+    centre : array_like (3,) or "mean"
+        Map centre for a new axes: a direction, or the density's mean direction.
+    extent : float, optional
+        Half-width of the view in map units (2 = the whole sphere); default global.
+    ax : GeoAxes, optional
+    cmap, iso_color
+        Colour map of the density and colour of the isopleth lines.
+    colorbar : bool
+    labels : dict, optional
+        Sensor-axis labels for :func:`decorate` (``{}`` for none).
+    grid_step_deg : float, optional
+        Gridline spacing (default 30°, 10° for a zoomed view).
+    point_kw : dict, optional
+    title : str, optional
+
+    Returns
+    -------
+    GeoAxes
+    """
+    from matplotlib.lines import Line2D
+
+    if not isinstance(kde, S.SphericalKDE):
+        raise TypeError(
+            f"kde must be a tiltlab.sphere.SphericalKDE, got {type(kde).__name__}"
+        )
+    if isinstance(centre, str):
+        if centre != "mean":
+            raise ValueError(f"centre must be a direction or 'mean', got {centre!r}")
+        centre = S.vmf_fit(kde.grid.centres().reshape(-1, 3), kde.density.ravel()).mu
+    ax = _map_ax(ax, centre=centre)
+    d = np.array(kde.density, float)
+    if cut is not None:
+        d = np.where(S.isopleth_mask(kde, cut), d, np.nan)
+    if scale == "sqrt":
+        shown, name = np.sqrt(d), label("√density", "sr^-1/2")
+    elif scale == "linear":
+        shown, name = d, label("density", "1/sr")
+    elif scale == "log":
+        with np.errstate(divide="ignore", invalid="ignore"):
+            shown = np.where(d > 0, np.log10(d), np.nan)
+        name = label("log10 density", "1/sr")
+    else:
+        raise ValueError(f"scale must be 'sqrt', 'linear' or 'log', got {scale!r}")
+    art = plot_grid(ax, shown, kde.grid, cmap=cmap)
+    levels = sorted(float(x) for x in np.atleast_1d(levels))
+    styles = ["-", "--", ":", "-."]
+    handles = []
+    for k, lev in enumerate(levels):
+        ls = styles[k % len(styles)]
+        plot_isopleths(ax, kde, [lev], colors=iso_color, linestyles=ls)
+        handles.append(
+            Line2D(
+                [],
+                [],
+                color=iso_color if iso_color != "w" else "k",
+                ls=ls,
+                label=f"{100 * lev:g} % isopleth",
+            )
+        )
+    if points is not None:
+        pts = S.as_unit_vectors(points, "points", allow_nan=True)
+        plot_points(
+            ax,
+            pts,
+            **(
+                {"ls": "none", "marker": ".", "ms": 1, "color": "darkgreen"}
+                | (point_kw or {})
+            ),
+        )
+        handles.append(
+            Line2D(
+                [],
+                [],
+                ls="none",
+                marker=".",
+                color=(point_kw or {}).get("color", "darkgreen"),
+                label="samples",
+            )
+        )
+    if extent is not None:
+        e = float(extent)
+        ax.set_extent([-e, e, -e, e], crs=ax.projection)
+    step = (
+        grid_step_deg
+        if grid_step_deg is not None
+        else (10.0 if extent is not None and extent < 1 else 30.0)
+    )
+    decorate(ax, labels=labels, grid_step_deg=step, fontsize=7)
+    if colorbar:
+        _colorbar(ax, art, name)
+    ax.legend(
+        handles=handles,
+        loc="upper center",
+        bbox_to_anchor=(0.5, -0.02),
+        fontsize=8,
+        frameon=False,
+        ncol=len(handles),
+    )
+    if title:
+        ax.set_title(title, fontsize=9)
+    return ax
+
+
+def tilt_points_map(
+    points,
+    *,
+    names=None,
+    baseline=None,
+    ax=None,
+    extent: float = 0.8,
+    grid_step_deg: float = 10.0,
+    title: str | None = None,
+    **kw,
+):
+    """Mean tilt points (e.g. one per session) on a zoomed LAEA map, optionally with a baseline at the pole.
+
+    Parameters
+    ----------
+    points : array_like (K, 3) or mapping str → (3,)
+        Directions; a mapping names them (legend entries).
+    names : sequence of str, optional
+        Names of the rows of an array.
+    baseline : array_like (3,) or str, optional
+        Rotate every point so that the baseline (a direction, or the name of a point)
+        sits at the pole (Fayat et al. Fig. 3e): distances to the pole are then distances
+        to the baseline.
+    ax : GeoAxes, optional
+    extent : float
+        Half-width of the view in map units.
+    grid_step_deg : float
+    title : str, optional
+    **kw
+        Marker style.
+
+    Returns
+    -------
+    GeoAxes
+    """
+    if isinstance(points, Mapping):
+        names, pts = (
+            list(points),
+            np.stack([np.asarray(v, float) for v in points.values()]),
+        )
+    else:
+        pts = np.atleast_2d(np.asarray(points, float))
+        names = (
+            list(names)
+            if names is not None
+            else [f"point {k}" for k in range(len(pts))]
+        )
+    if len(names) != len(pts):
+        raise ValueError(f"{len(names)} names for {len(pts)} points")
+    if baseline is not None:
+        b = (
+            pts[names.index(baseline)]
+            if isinstance(baseline, str)
+            else np.asarray(baseline, float)
+        )
+        pts = S.rotate_to_pole(pts, b)
+    ax = _map_ax(ax)
+    for k, (name, p) in enumerate(zip(names, pts)):
+        plot_points(
+            ax,
+            p[None],
+            **({"marker": "o", "ms": 5, "ls": "none", "color": f"C{k}"} | kw),
+            label=name,
+        )
+    ax.set_extent([-extent, extent, -extent, extent], crs=ax.projection)
+    decorate(
+        ax,
+        fontsize=7,
+        grid_step_deg=grid_step_deg,
+        labels={} if baseline is not None else None,
+    )
+    legend_if_many(ax, loc="upper center", bbox_to_anchor=(0.5, -0.02), frameon=False)
+    if title:
+        ax.set_title(title, fontsize=9)
+    return ax
+
+
+def tilt_trace(tilt, *, ax=None, title: str | None = None, **kw):
+    """A tilt trajectory on the plane of the head-tilt LAEA projection (no map axes needed).
+
+    +x (nose) points up and +y (left ear) left, as seen from above the head; the dashed
+    circle of radius √2 is the horizon (tilt 90°).
+
+    Parameters
+    ----------
+    tilt : xarray.DataArray, xarray.Dataset or array_like
+        Tilt vectors (a labelled (time, axis) series, a Recording with ``gravity``, or (N, 3)).
+    ax : matplotlib.axes.Axes, optional
+    title : str, optional
+    **kw
+        Style of the trajectory line.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+    """
+    from ._common import new_axes
+
+    g = S.as_unit_vectors(tilt, "tilt", allow_nan=True)
+    ax = new_axes(ax, figsize=(4.5, 4.5))
+    xy = project(tilt_projection(), g)
+    ax.plot(
+        *xy.T,
+        **({"lw": 0.2, "color": "k", "alpha": 0.5, "label": "tilt trajectory"} | kw),
+    )
+    ax.add_patch(
+        plt.Circle(
+            (0, 0),
+            np.sqrt(2),
+            fill=False,
+            color="tab:blue",
+            ls="--",
+            label="horizon (90° tilt)",
+        )
+    )
+    ax.set(
+        aspect="equal",
+        xlim=(-2.05, 2.05),
+        ylim=(-2.05, 2.05),
+        xlabel="LAEA x: ← left ear (+y)   right ear →",
+        ylabel="LAEA y: nose (+x) ↑",
+    )
+    ax.legend(loc="lower right", fontsize=7)
+    if title:
+        ax.set_title(title, fontsize=9)
+    return ax
+
+
+def residence_figure(
+    res,
+    mesh: S.SphereMesh,
+    *,
+    series=None,
+    cmap="cividis",
+    figsize=None,
+    panel_titles: tuple[str, str] = (
+        "number of visits",
+        "mean residence time per visit",
+    ),
+):
+    """Maps of visits and mean residence time per cap, and optionally RT(i), NV(i) along the trajectory.
+
+    Parameters
+    ----------
+    res : tiltlab.sphere.Residence
+        From :func:`tiltlab.sphere.residence` with the mesh's facet centroids as centres.
+    mesh : SphereMesh
+        The mesh whose centroids were the cap centres.
+    series : tuple (time, RT, NV), optional
+        Times (s) and values from :func:`tiltlab.sphere.residence_series` (convert its
+        sample index to seconds first).
+    cmap : str or Colormap
+    figsize : (float, float), optional
+    panel_titles : (str, str)
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    n = 3 if series is not None else 2
+    fig = plt.figure(figsize=figsize or (4.1 * n, 4.4))
+    visited = res.n_visits > 0
+    for j, (name, v, u) in enumerate(
+        [
+            (panel_titles[0], res.n_visits.astype(float), "1"),
+            (panel_titles[1], res.mean_residence, "s"),
+        ]
+    ):
+        ax = map_axes(fig, (1, n, j + 1))
+        facet_map(
+            np.where(visited, v, np.nan),
+            mesh,
+            ax=ax,
+            name=name.split(" per ")[0],
+            units=u,
+            cmap=cmap,
+            decorate_kw={"fontsize": 7},
+            title=name,
+        )
+    if series is not None:
+        t, rt, nv = series
+        ax = fig.add_subplot(1, n, 3)
+        ax.plot(t, rt, lw=0.8, label="RT(i) (s)")
+        ax.plot(t, nv, lw=0.8, label="NV(i) (visits)")
+        ax.set(
+            xlabel=label("time", "s"),
+            ylabel=label("RT (s) / NV", None),
+            title="App. C along the trajectory",
+        )
+        ax.legend(fontsize=8)
+    fig.tight_layout()
+    return fig
