@@ -291,8 +291,7 @@ def test_residence_figure(no_cartopy_data, tilt, mesh):
     fig.canvas.draw()
 
 
-def test_spheremaps_is_a_thin_reexport_without_offline():
-    from tiltlab import spheremaps as SM
+def test_old_spheremaps_module_is_gone():
+    with pytest.raises(ImportError):
+        import tiltlab.spheremaps  # noqa: F401
 
-    assert SM.map_axes is plot.map_axes and SM.decorate is plot.decorate
-    assert not hasattr(SM, "offline")

@@ -1,4 +1,4 @@
-"""Tests of tiltlab.sphere (triangulated sphere, vMF, spherical KDE, residence) and tiltlab.spheremaps
+"""Tests of tiltlab.sphere (triangulated sphere, vMF, spherical KDE, residence) and the sphere maps of tiltlab.plot
 (the LAEA projection, now in tiltlab.plot.maps)."""
 
 import numpy as np
@@ -508,7 +508,7 @@ def test_laea_maps_render_without_cartopy_data_and_preserve_area(no_cartopy_data
     import cartopy.crs as ccrs
     import matplotlib.pyplot as plt
 
-    from tiltlab import spheremaps as SM
+    from tiltlab import plot as SM
 
     m = S.sphere_mesh(2000)
     rng = np.random.default_rng(13)
@@ -543,7 +543,7 @@ def test_laea_maps_render_without_cartopy_data_and_preserve_area(no_cartopy_data
 
 def test_tilt_map_projection_is_equal_area():
     from tiltlab import quaternion
-    from tiltlab import spheremaps as SM
+    from tiltlab import plot as SM
 
     proj = SM.tilt_projection()
     np.testing.assert_allclose(

@@ -49,6 +49,9 @@ __all__ = [
     "nonnegative",
     "integer",
     "fraction",
+    "output",
+    "start_time",
+    "windowed",
 ]
 
 
@@ -286,7 +289,7 @@ def signal(
         where = f"Recording variable {key!r}"
         labelled = True
     elif isinstance(data, xr.DataArray):
-        da = data
+        da = data.transpose("time", ...) if "time" in data.dims else data
         attrs = dict(da.attrs)
         own_fs = da.attrs.get("fs")
         own_units = da.attrs.get("units")
@@ -381,6 +384,44 @@ def labelled(
     if attrs:
         a.update(attrs)
     return xr.DataArray(values, dims=dims, coords=c, name=name, attrs=a)
+
+
+def output(values, like: Signal, name: str, units: str | None = None, attrs=None):
+    """A per-sample (or scalar) result, labelled exactly when ``like`` was.
+
+    Per-sample arrays become DataArrays with the input's ``time`` coordinate and ``fs``
+    (:func:`labelled`); a scalar becomes a 0-d DataArray carrying ``units``.
+    """
+    if not like.labelled:
+        return values
+    values = np.asarray(values)
+    if values.ndim == 0:
+        a = {} if units is None else {"units": units}
+        return xr.DataArray(values, name=name, attrs={**a, **(attrs or {})})
+    return labelled(values, like, name, units=units, attrs=attrs)
+
+
+def start_time(like: Signal) -> float:
+    """Time (s) of the first sample of a labelled input (0 without a time coordinate)."""
+    if like.time is not None and like.time.size:
+        return float(like.time[0])
+    return 0.0
+
+
+def windowed(values, like: Signal, name: str, *, centre_s, fs_out: float, units=None):
+    """One value per window: a DataArray over window-centre times when ``like`` was
+    labelled (``centre_s`` relative to the first sample; ``fs_out`` = windows per s)."""
+    if not like.labelled:
+        return values
+    values = np.asarray(values)
+    dims = ("time", "axis") if values.ndim == 2 and values.shape[1] == 3 else ("time",)
+    coords = {"time": start_time(like) + np.asarray(centre_s, float)}
+    if "axis" in dims:
+        coords["axis"] = ["x", "y", "z"]
+    attrs = {"fs": float(fs_out)}
+    if units is not None:
+        attrs["units"] = units
+    return xr.DataArray(values, dims=dims, coords=coords, name=name, attrs=attrs)
 
 
 # imported last: tiltlab.units re-exports check_fs from this module

@@ -12,7 +12,7 @@ Submodules
   speed traces and histograms;
 * :mod:`~tiltlab.plot.maps` — sphere figures: LAEA maps on a unit globe (cartopy), 3-D
   facet renderings, time-on-sphere heat maps, visited facets, KDE maps with isopleths,
-  grids of maps, residence maps (formerly :mod:`tiltlab.spheremaps`);
+  grids of maps, residence maps ;
 * :mod:`~tiltlab.plot.scores` — estimator errors: parameter-grid heat maps and curves,
   per-trial bars, ECDFs, errors binned by speed;
 * :mod:`~tiltlab.plot.cohort` — Tukey boxplots and group means for cohort tables.

@@ -23,8 +23,7 @@ DataArray — e.g. ``filters.gravity(filters.estimate(rec, method))``, whose ``f
 or a plain (N, 3) array with ``fs=``/``times=``.
 
 Map figures (3-D sphere, Lambert azimuthal equal-area with cartopy, heat maps, KDE
-maps) are in :mod:`tiltlab.plot` (:mod:`tiltlab.plot.maps`; :mod:`tiltlab.spheremaps`
-re-exports the map primitives).
+maps) are in :mod:`tiltlab.plot` (:mod:`tiltlab.plot.maps`, :mod:`tiltlab.plot.mapfigures`).
 """
 
 from .mesh import (
