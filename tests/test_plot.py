@@ -294,4 +294,3 @@ def test_residence_figure(no_cartopy_data, tilt, mesh):
 def test_old_spheremaps_module_is_gone():
     with pytest.raises(ImportError):
         import tiltlab.spheremaps  # noqa: F401
-

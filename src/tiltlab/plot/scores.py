@@ -1,7 +1,7 @@
 """Figures of estimator errors: parameter-grid heat maps and curves, per-trial bars,
 error distributions and errors binned by angular speed.
 
-Inputs are the tables that :mod:`tiltlab.evaluate` and :func:`tiltlab.filters.grid_search`
+Inputs are the tables that :mod:`tiltlab.evaluate` and :func:`tiltlab.evaluate.grid_search`
 return (labelled DataArrays / Datasets, pandas DataFrames). Every recipe takes the data
 first and an optional ``ax``, labels its axes with units and adds a legend when it
 draws several lines.
@@ -44,7 +44,7 @@ def score_heatmap(
     ----------
     scores : xarray.DataArray
         Two dimensions (the parameters; e.g. ``grid.sel(shift=0).mean("recording")`` of
-        a :func:`tiltlab.filters.grid_search` result). The first is drawn on y, the
+        a :func:`tiltlab.evaluate.grid_search` result). The first is drawn on y, the
         second on x; coordinate values label the ticks.
     ax : matplotlib.axes.Axes, optional
     log : bool
@@ -142,6 +142,10 @@ def score_curves(
             ax.plot(xv, scores.sel({hue: h}).transpose(x).values, "o-", label=str(h))
     if logx:
         ax.set_xscale("log")
+        # ticks at the parameter values: log minor labels overlap on short decades
+        ax.set_xticks(xv)
+        ax.set_xticklabels([f"{v:g}" for v in xv])
+        ax.minorticks_off()
     if logy:
         ax.set_yscale("log")
     ax.set_xlabel(label(x, scores[x].attrs.get("units")))
@@ -161,7 +165,7 @@ def trial_bars(
     units: str | None = None,
     legend_title: str = "estimator",
     title: str | None = None,
-    figsize=(11, 5),
+    figsize=(9, 5),
 ):
     """Grouped bars: one group per trial, one bar per estimator (or any column).
 
