@@ -199,3 +199,140 @@ def test_netcdf_round_trip_real_trial(tmp_path, data_mirror):
     rec = io.read_broad(data_mirror / "broad" / "02_undisturbed_slow_rotation_B.hdf5")
     back = io.load_netcdf(io.save_netcdf(rec, tmp_path / "t.nc"), validate=True)
     xr.testing.assert_identical(back, rec)
+
+
+# --------------------------------------------------------------------------- generic CSV with a mapping
+
+
+def _lab_csv(path, *, n=600, fs=300.0, time_factor=1e3, sep=","):
+    """A lab's own CSV: time in ms (by default), acc in g, gyro in deg/s, temperature."""
+    rng = np.random.default_rng(7)
+    acc = rng.normal(0, 0.01, (n, 3)) + [0, 0, 1.0]
+    gyr = rng.normal(0, 1.0, (n, 3))
+    t = 1234.5 + np.arange(n) / fs * time_factor
+    head = sep.join(["t_ms", "AccX", "AccY", "AccZ", "GyrX", "GyrY", "GyrZ", "T"])
+    rows = [
+        sep.join(f"{v:.17g}" for v in (t[i], *acc[i], *gyr[i], 30.0)) for i in range(n)
+    ]
+    path.write_text("\n".join([head, *rows]) + "\n")
+    return acc, gyr, t
+
+
+MAPPING = {
+    "columns": {
+        "acc": ["AccX", "AccY", "AccZ"],
+        "gyr": ["GyrX", "GyrY", "GyrZ"],
+        "temp": "T",
+    },
+    "units": {"acc": "g", "gyr": "deg/s", "temp": "degC"},
+    "time_column": "t_ms",
+    "time_units": "ms",
+}
+
+
+def test_csv_mapping_from_json_file(tmp_path):
+    import json
+
+    p = tmp_path / "session.csv"
+    acc, gyr, t = _lab_csv(p, sep=";")
+    mp = tmp_path / "mapping.json"
+    mp.write_text(json.dumps({**MAPPING, "sep": ";", "attrs": {"subject": "rat 3"}}))
+    checked = io.read_csv_mapping(mp)
+    assert checked["time_scale"] == 1e-3 and checked["read_csv"] == {"sep": ";"}
+    assert checked["columns"]["temp"] == ["T"]
+    for rec in (io.read_csv(p, mapping=mp), io.read_csv(p, mapping=str(mp))):
+        assert rec.attrs["fs"] == pytest.approx(300.0)
+        assert rec.attrs["subject"] == "rat 3" and "ms" in rec.attrs["fs_source"]
+        np.testing.assert_array_equal(rec.acc.values, acc)
+        np.testing.assert_allclose(rec.time.values, t / 1e3, rtol=1e-15)
+        assert rec.gyr.attrs["units"] == "deg/s"
+    # explicit arguments override the mapping
+    rec = io.read_csv(p, mapping=mp, fs=300.0, attrs={"subject": "rat 4"})
+    assert rec.attrs["fs"] == 300.0 and rec.attrs["subject"] == "rat 4"
+    assert "fs_source" not in rec.attrs
+
+
+@pytest.mark.parametrize(
+    "time_spec",
+    [
+        {"time_units": "ms"},
+        {"time_scale": 1e-3},
+        {"units": {"acc": "g", "gyr": "deg/s", "temp": "degC", "time": "ms"}},
+    ],
+)
+def test_csv_time_column_in_ms(tmp_path, time_spec):
+    p = tmp_path / "s.csv"
+    _lab_csv(p)
+    m = {k: v for k, v in MAPPING.items() if k != "time_units"} | time_spec
+    rec = io.read_csv(p, mapping=m)
+    assert rec.attrs["fs"] == pytest.approx(300.0)
+    assert rec.time.values[0] == pytest.approx(1.2345)
+
+
+def test_csv_time_in_us_and_keyword_arguments(tmp_path):
+    p = tmp_path / "s.csv"
+    _lab_csv(p, fs=100.0, time_factor=1e6)
+    rec = io.read_csv(
+        p,
+        MAPPING["columns"],
+        MAPPING["units"],
+        time_column="t_ms",
+        time_units="us",
+    )
+    assert rec.attrs["fs"] == pytest.approx(100.0)
+
+
+def test_csv_implausible_fs_suggests_the_time_unit(tmp_path):
+    p = tmp_path / "s.csv"
+    _lab_csv(p)
+    m = {k: v for k, v in MAPPING.items() if k != "time_units"}
+    # time column read as seconds: 0.3 Hz, and the message says it is probably ms
+    with pytest.raises(ValueError, match=r"0\.3 Hz.*time_units='ms'.*300 Hz"):
+        io.read_csv(p, mapping=m)
+    # an fs that the time column contradicts
+    with pytest.raises(ValueError, match="fs = 300 Hz but time column 't_ms'"):
+        io.read_csv(p, mapping={**m, "fs": 300})
+    with pytest.raises(ValueError, match="outside the plausible range"):
+        io.read_csv(p, mapping={**MAPPING, "fs_range": [1000, 5000]})
+    # the check can be switched off
+    rec = io.read_csv(p, mapping=m, fs_range=None)
+    assert rec.attrs["fs"] == pytest.approx(0.3)
+    with pytest.raises(ValueError, match="time unit is given twice"):
+        io.read_csv(p, mapping={**MAPPING, "time_scale": 1e-6})
+    with pytest.raises(ValueError, match="time_units must be one of"):
+        io.read_csv(p, mapping={**MAPPING, "time_units": "minutes"})
+
+
+def test_csv_missing_column_is_named_with_the_available_ones(tmp_path):
+    p = tmp_path / "s.csv"
+    _lab_csv(p)
+    m = {**MAPPING, "columns": {**MAPPING["columns"], "acc": ["AccX", "AccY", "Acc_Z"]}}
+    with pytest.raises(ReadError) as err:
+        io.read_csv(p, mapping=m)
+    msg = str(err.value)
+    assert "'Acc_Z' (mapped to acc)" in msg and "did you mean 'AccZ'" in msg
+    assert "available columns: 't_ms', 'AccX'" in msg
+    with pytest.raises(ReadError, match=r"'time' \(time_column\)"):
+        io.read_csv(p, mapping={**MAPPING, "time_column": "time"})
+    # a wrong separator leaves one column: the message says so
+    with pytest.raises(ReadError, match="is the separator right"):
+        io.read_csv(p, mapping={**MAPPING, "sep": ";"})
+
+
+def test_csv_mapping_errors(tmp_path):
+    bad = tmp_path / "bad.json"
+    bad.write_text('{"columns": {"acc": ["a", "b"}')
+    with pytest.raises(ValueError, match=r"bad.json: not valid JSON \(line 1"):
+        io.read_csv_mapping(bad)
+    with pytest.raises(ReadError, match="no such mapping file"):
+        io.read_csv_mapping(tmp_path / "nothing.json")
+    with pytest.raises(ValueError, match=r"unknown key\(s\) \['colums'\]"):
+        io.read_csv_mapping({"colums": {}, **MAPPING})
+    with pytest.raises(ValueError, match=r"columns\['acc'\] needs 3 column"):
+        io.read_csv_mapping({**MAPPING, "columns": {"acc": ["a", "b"], "gyr": "g"}})
+    with pytest.raises(ValueError, match=r"units\['gyr'\]: unknown unit 'rpm'"):
+        io.read_csv_mapping({**MAPPING, "units": {"acc": "g", "gyr": "rpm"}})
+    with pytest.raises(ValueError, match="never assumes a sampling rate"):
+        io.read_csv_mapping({"columns": MAPPING["columns"], "units": MAPPING["units"]})
+    with pytest.raises(ValueError, match="pandas.read_csv does not take"):
+        io.read_csv_mapping({**MAPPING, "read_csv": {"nope": 1}})

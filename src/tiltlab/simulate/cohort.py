@@ -24,13 +24,21 @@ numbers published by the authors; the planted values of every session are writte
 Directory layout::
 
     cohort/
+      manifest.csv    the cohort manifest read by :func:`tiltlab.cohort.read_manifest`:
+                      session, subject, group, timepoint, file, reader (netcdf),
+                      reader_options (empty), calibration (the animal's tumble test)
+                      and the covariate hours
       sessions.csv    one row per session: subject, group, time_point, hours, file
       truth.csv       planted and realised effects per session (realised: state fraction
                       immobile, fraction of true angular speed < 12 °/s, angle to the xz
                       plane of the baseline tilt point and of the mean immobile tilt,
-                      mean azimuthal rotation during active states)
+                      mean azimuthal rotation during active states) and the features
+                      of :mod:`tiltlab.cohort` applied to the true motion
+                      (``*_true`` columns, see :func:`_true_features`)
       design.json     design, effect tables, seed, duration, fs
       sessions/<subject>_<time_point>.nc   one Recording per session (tiltlab.io.save_netcdf)
+      calibration/<subject>_tumble.nc      one tumble test per animal, recorded with the
+                                           animal's IMU (Fayat App. A.1)
 
 References
 ----------
@@ -43,7 +51,7 @@ import json
 import math
 from collections.abc import Iterator
 from concurrent.futures import ProcessPoolExecutor, as_completed
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -52,8 +60,13 @@ import xarray as xr
 
 from .. import io as _io
 from .. import quaternion as _quat
-from .kinematics import STATES, BehaviourParams, Lesion, head_kinematics
+from ..behavior import detect_immobility
+from .kinematics import STATES, BehaviourParams, Lesion, TrueMotion, head_kinematics
 from .sensor import SensorModel, draw_sensor, recording_from_motion
+from .tumble import tumble_test
+
+#: Fayat et al.'s immobility rules (§2.9): threshold (°/s), merge gap (s), minimum (s)
+_IMMOBILITY_RULES = {"threshold_deg_s": 12.0, "merge_gap_s": 0.1, "min_duration_s": 0.5}
 
 __all__ = [
     "TIME_POINTS",
@@ -203,6 +216,30 @@ class CohortDesign:
         """Fayat's design with ``n_per_group`` animals in every group (for tests and the book)."""
         return cls(groups={g: n_per_group for g in FAYAT_GROUPS}, **kwargs)
 
+    def select(self, *, groups: dict | None = None, time_points=None) -> "CohortDesign":
+        """This design restricted to some time points (effect tables cut to match) and
+        with other group sizes (``groups``: name → number of animals, names from
+        ``effects``)."""
+        tps = list(self.time_points if time_points is None else time_points)
+        unknown = [t for t in tps if t not in self.time_points]
+        if unknown:
+            raise ValueError(
+                f"unknown time point(s) {unknown}; known {self.time_points}"
+            )
+        idx = [list(self.time_points).index(t) for t in tps]
+
+        def cut(table):
+            return {k: tuple(v[i] for i in idx) for k, v in table.items()}
+
+        return replace(
+            self,
+            groups=dict(self.groups if groups is None else groups),
+            time_points=tuple(tps),
+            hours=tuple(self.hours[i] for i in idx),
+            effects={g: cut(e) for g, e in self.effects.items()},
+            anaesthesia=cut(self.anaesthesia),
+        )
+
     def to_dict(self) -> dict:
         d = asdict(self)
         d["time_points"], d["hours"] = list(self.time_points), list(self.hours)
@@ -276,7 +313,9 @@ def session_plan(
                     "group": grp,
                     "time_point": tp,
                     "hours": float(hr),
+                    "session": f"{subj}_{tp}",
                     "file": f"sessions/{subj}_{tp}.nc",
+                    "calibration": f"calibration/{subj}_tumble.nc",
                     "animal_index": a,
                     "session_index": t,
                     "seed": seed,
@@ -298,6 +337,56 @@ def session_plan(
     return pd.DataFrame(rows)
 
 
+def _animal_sensor(row: dict) -> SensorModel:
+    """The animal's IMU: errors from the animal's seed; temperatures left to each recording."""
+    sensor = draw_sensor(SensorModel(), np.random.default_rng(row["imu_seed"]))
+    return SensorModel(**{**sensor.__dict__, "temp_start": None, "temp_end": None})
+
+
+def _simulate_tumble(row: dict, out_dir: str) -> str:
+    """Simulate and write the tumble test of one animal (its own IMU; run in a worker)."""
+    rec = tumble_test(
+        50,
+        300.0,
+        seed=np.random.SeedSequence([row["seed"], row["animal_index"], 3]),
+        sensor=_animal_sensor(row),
+    )
+    rec.attrs.update(subject=row["subject"], session="tumble test")
+    _io.save_netcdf(rec, Path(out_dir) / row["calibration"])
+    return row["calibration"]
+
+
+def _true_features(motion: TrueMotion, side_sign: float) -> dict:
+    """The features of :mod:`tiltlab.cohort` computed on the TRUE motion.
+
+    Why this is the truth to recover: a feature such as "immobile fraction" is defined
+    by a rule set applied to an angular speed (Fayat §2.9: < 12 °/s, gaps < 0.1 s
+    merged, periods < 0.5 s dropped), not by the simulator's behavioural states, which
+    include slow movements and brief still moments that no speed rule can (or should)
+    classify the same way. Applying the same definitions to the true angular velocity
+    and the true tilt gives what a perfect sensor and a perfect orientation estimate
+    would measure; the difference between a pipeline's output and these values is then
+    purely measurement error (sensor noise and offsets, calibration, filter), which is
+    what a recovery test must bound.
+    """
+    speed = np.degrees(np.linalg.norm(motion.omega, axis=1))
+    imm = np.asarray(detect_immobility(speed, motion.fs, **_IMMOBILITY_RULES))
+    gs = _quat.gravity(motion.q)
+    out = {"immobile_fraction_true": float(np.mean(imm))}
+    mu = gs[imm].sum(axis=0) if imm.any() else np.full(3, np.nan)
+    mu = mu / np.linalg.norm(mu)
+    out.update({f"tilt_immobile_{a}_true": float(v) for a, v in zip("xyz", mu)})
+    out["tilt_sagittal_deg_true"] = float(
+        np.degrees(np.arcsin(np.clip(-side_sign * mu[1], -1, 1)))
+    )
+    az = np.degrees(np.sum(motion.omega * gs, axis=1))  # ω·g_s, °/s
+    moving = ~imm
+    out["circling_index_cpm_true"] = (
+        float(np.mean(az[moving]) * 60.0 / 360.0) if moving.any() else np.nan
+    )
+    return out
+
+
 def _simulate_one(row: dict, out_dir: str, keep_true: bool) -> dict:
     """Simulate and write one session; returns the realised truth (run in a worker)."""
     beh = BehaviourParams(
@@ -313,8 +402,7 @@ def _simulate_one(row: dict, out_dir: str, keep_true: bool) -> dict:
         side=row["lesion_side"],
     )
     # the animal keeps its IMU: sensor errors from the animal's seed, temperatures per session
-    sensor = draw_sensor(SensorModel(), np.random.default_rng(row["imu_seed"]))
-    sensor = SensorModel(**{**sensor.__dict__, "temp_start": None, "temp_end": None})
+    sensor = _animal_sensor(row)
     rng = np.random.default_rng(
         np.random.SeedSequence(
             [row["seed"], row["animal_index"], row["session_index"], 2]
@@ -359,6 +447,7 @@ def _simulate_one(row: dict, out_dir: str, keep_true: bool) -> dict:
         "baseline_tilt_y": float(g[1]),
         "baseline_tilt_z": float(g[2]),
         "circling_cpm_realised": float(row["side_sign"] * cpm),
+        **_true_features(motion, row["side_sign"]),
         "true_gyr_offset_mean": json.dumps(rec.attrs["true_gyr_offset_mean"]),
         "true_acc_offset_mean": json.dumps(rec.attrs["true_acc_offset_mean"]),
     }
@@ -375,6 +464,7 @@ def simulate_cohort(
     progress: bool = True,
     keep_true: bool = False,
     overwrite: bool = False,
+    calibration: bool = True,
 ) -> Path:
     """Simulate a lesion cohort into a directory that reads like real data.
 
@@ -397,11 +487,16 @@ def simulate_cohort(
         Also store ``acc_true``, ``gyr_true`` and ``pos`` in each session.
     overwrite : bool
         Allow writing into a directory that already holds a cohort.
+    calibration : bool
+        Also write one tumble test per animal (``calibration/<subject>_tumble.nc``,
+        50 Fibonacci orientations at 300 Hz, recorded with the animal's IMU) and name
+        it in the manifest's ``calibration`` column.
 
     Returns
     -------
     pathlib.Path
-        The cohort directory (read it with :func:`load_cohort`).
+        The cohort directory (read it with :func:`load_cohort`, or its
+        ``manifest.csv`` with :func:`tiltlab.cohort.read_manifest`).
     """
     from tqdm import tqdm
 
@@ -418,24 +513,31 @@ def simulate_cohort(
     (path / "sessions").mkdir(parents=True, exist_ok=True)
     plan = session_plan(design, seed=seed, duration_s=duration_s, fs=fs)
     rows = plan.to_dict("records")
+    animals = list({r["subject"]: r for r in rows}.values()) if calibration else []
     # compile (or load cached) kernels once here so that workers find them in the cache
     head_kinematics(0.1, fs, seed=0)
     results = []
     bar = tqdm(
-        total=len(rows),
+        total=len(rows) + len(animals),
         desc="simulating sessions",
-        unit="session",
+        unit="recording",
         disable=not progress,
     )
     if workers == 1:
+        for r in animals:
+            _simulate_tumble(r, str(path))
+            bar.update()
         for r in rows:
             results.append(_simulate_one(r, str(path), keep_true))
             bar.update()
     else:
         with ProcessPoolExecutor(max_workers=workers) as ex:
-            futs = [ex.submit(_simulate_one, r, str(path), keep_true) for r in rows]
+            futs = [ex.submit(_simulate_tumble, r, str(path)) for r in animals]
+            futs += [ex.submit(_simulate_one, r, str(path), keep_true) for r in rows]
             for fu in as_completed(futs):
-                results.append(fu.result())
+                res = fu.result()
+                if isinstance(res, dict):
+                    results.append(res)
                 bar.update()
     bar.close()
     real = pd.DataFrame(results).set_index("file").loc[plan["file"]].reset_index()
@@ -443,6 +545,21 @@ def simulate_cohort(
     plan[["subject", "group", "time_point", "hours", "file"]].to_csv(
         path / "sessions.csv", index=False
     )
+    # the cohort manifest of tiltlab.cohort (written here: the simulator sits below it)
+    manifest = pd.DataFrame(
+        {
+            "session": plan["session"],
+            "subject": plan["subject"],
+            "group": plan["group"],
+            "timepoint": plan["time_point"],
+            "file": plan["file"],
+            "reader": "netcdf",
+            "reader_options": "",
+            "calibration": plan["calibration"] if calibration else "",
+            "hours": plan["hours"],
+        }
+    )
+    manifest.to_csv(path / "manifest.csv", index=False)
     truth.to_csv(path / "truth.csv", index=False)
     meta = {
         "design": design.to_dict(),

@@ -1,0 +1,79 @@
+r"""Cohorts: from a lab's folder of sessions to one feature table (layer 7).
+
+* :mod:`~tiltlab.cohort.manifest` — the cohort manifest (one CSV row per session:
+  ``session, subject, group, timepoint, file, reader, reader_options, calibration`` and
+  covariates), :func:`read_manifest` (rejects a malformed manifest before any work,
+  naming the row), :func:`init_manifest` (from files matching a pattern such as
+  ``"{group}/{subject}_{timepoint}.nc"``), :func:`load_session`;
+* :mod:`~tiltlab.cohort.config` — :class:`FeatureConfig`, every choice of the
+  pipeline, frozen, validated, serialisable and hashed;
+* :mod:`~tiltlab.cohort.features` — :func:`session_features`: calibration →
+  orientation → tilt → features (immobility, visited sphere, vMF mean tilt and its
+  sagittal angle, circling, angular speed, DBA, time tilted) of one session (Fayat et
+  al. 2021, §2.7–2.10, §3.3–3.4);
+* :mod:`~tiltlab.cohort.run` — :func:`run_cohort` (serial, local processes or
+  ``dask.distributed``, one code path; a per-session disk cache; failed sessions
+  recorded, never lost), :func:`summary`, :func:`save_features`,
+  :func:`load_features`.
+
+Example
+-------
+>>> from tiltlab import cohort                                   # doctest: +SKIP
+>>> m = cohort.read_manifest("study/manifest.csv")               # doctest: +SKIP
+>>> feats = cohort.run_cohort(m, cohort.FeatureConfig(), workers=4)  # doctest: +SKIP
+>>> print(cohort.summary(feats))                                 # doctest: +SKIP
+
+References
+----------
+.. [1] R. Fayat et al., "Inertial Measurement of Head Tilt in Rodents: Principles and
+   Applications to Vestibular Research", Sensors 21(18):6318, 2021.
+   doi:10.3390/s21186318
+"""
+
+from .config import FeatureConfig
+from .features import empty_features, feature_specs, session_features
+from .manifest import (
+    OPTIONAL_COLUMNS,
+    READERS,
+    REQUIRED_COLUMNS,
+    Manifest,
+    ManifestError,
+    init_manifest,
+    load_calibration,
+    load_session,
+    read_manifest,
+    session_path,
+)
+from .run import (
+    CohortSummary,
+    cache_key,
+    compute_session,
+    load_features,
+    run_cohort,
+    save_features,
+    summary,
+)
+
+__all__ = [
+    "FeatureConfig",
+    "feature_specs",
+    "empty_features",
+    "session_features",
+    "REQUIRED_COLUMNS",
+    "OPTIONAL_COLUMNS",
+    "READERS",
+    "Manifest",
+    "ManifestError",
+    "read_manifest",
+    "init_manifest",
+    "load_session",
+    "load_calibration",
+    "session_path",
+    "CohortSummary",
+    "cache_key",
+    "compute_session",
+    "run_cohort",
+    "summary",
+    "save_features",
+    "load_features",
+]

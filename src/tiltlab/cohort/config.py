@@ -1,0 +1,241 @@
+r"""The feature configuration: every choice that turns a session into its features.
+
+A :class:`FeatureConfig` is frozen, validated on construction and serialisable
+(:meth:`~FeatureConfig.to_dict`, :meth:`~FeatureConfig.from_dict`,
+:meth:`~FeatureConfig.to_json`); :meth:`~FeatureConfig.hash` is the SHA-256 of its
+canonical JSON, which keys the per-session cache of :func:`tiltlab.cohort.run_cohort`
+and is stored, with the JSON itself, in the attrs of every feature table.
+
+References
+----------
+.. [1] R. Fayat et al., "Inertial Measurement of Head Tilt in Rodents: Principles and
+   Applications to Vestibular Research", Sensors 21(18):6318, 2021.
+   doi:10.3390/s21186318
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+from dataclasses import dataclass, field, fields
+from typing import Any
+
+import numpy as np
+
+from .. import _validate as _v
+from .. import filters as _filters
+
+__all__ = ["FeatureConfig"]
+
+
+def _plain(v):
+    """A JSON-friendly copy of a parameter value (numpy → Python, tuples → lists)."""
+    if isinstance(v, np.generic):
+        return v.item()
+    if isinstance(v, (np.ndarray, list, tuple)):
+        return [_plain(x) for x in np.asarray(v, dtype=object).tolist()]
+    if isinstance(v, dict):
+        return {str(k): _plain(x) for k, x in v.items()}
+    return v
+
+
+@dataclass(frozen=True)
+class FeatureConfig:
+    r"""How a session's features are computed (Fayat et al. 2021, §2.5–2.10).
+
+    Parameters
+    ----------
+    method : str
+        Orientation method of :func:`tiltlab.filters.estimate` (any name of
+        :func:`tiltlab.filters.methods`). Default ``"smoother"``: the offline tilt
+        smoother, following chapter 5's benchmark (offline methods are the most
+        accurate on BROAD and the right tool for post-hoc analysis; the low-pass of the
+        accelerometer, Fayat's choice with ``cutoff_hz=2.0``, is the least accurate on
+        simulated freely moving rats). Use ``method="lowpass",
+        method_params={"cutoff_hz": 2.0}`` to reproduce Fayat et al.
+    method_params : dict
+        Parameters of the method; completed with the registry's defaults on
+        construction, so that the stored configuration names every value used.
+    use_mag : bool
+        Use the magnetometer (9D) where the method supports it.
+    calibration_model : {"offsets", "ellipsoid"}
+        Accelerometer model fitted to a tumble test
+        (:func:`tiltlab.calibration.tumble_calibration`): Fayat's offsets, or offsets
+        with scale and misalignment.
+    calibration_gyro : bool
+        Also apply the tumble test's gyroscope offsets (the session's own offset is
+        then estimated on top of them when ``gyr_offset="auto"``).
+    gyr_offset : {"auto", "none"}
+        Remove the session's gyroscope offset estimated from its quietest windows
+        (:func:`tiltlab.calibration.robust_gyro_offset`) before everything else.
+    threshold_deg_s, merge_gap_s, min_duration_s : float
+        Immobility rules (Fayat §2.9: 12 °/s, 0.1 s, 0.5 s).
+    auto_threshold : bool
+        Also compute immobility with the threshold at the valley of the angular-speed
+        distribution (:func:`tiltlab.behavior.valley_threshold`).
+    mesh_n : int
+        Vertices of the Fibonacci sphere mesh for the visited fraction (Fayat: 5000).
+    visited_min_count : int
+        Samples a facet needs to count as visited.
+    tilt_thresholds_deg : tuple of float
+        Angles (deg) between the tilt and +z beyond which the head counts as tilted.
+    speed_quantiles : tuple of float
+        Quantiles of the angular speed while moving.
+    dba_window_s : float
+        Window (s) of the static acceleration for DBA and ODBA.
+    lesion_side : {"left", "right"}
+        Side that makes the sagittal angle positive (Fayat §2.8, §3.3).
+    """
+
+    method: str = "smoother"
+    method_params: dict = field(default_factory=dict)
+    use_mag: bool = False
+    calibration_model: str = "offsets"
+    calibration_gyro: bool = False
+    gyr_offset: str = "auto"
+    threshold_deg_s: float = 12.0
+    merge_gap_s: float = 0.1
+    min_duration_s: float = 0.5
+    auto_threshold: bool = True
+    mesh_n: int = 5000
+    visited_min_count: int = 1
+    tilt_thresholds_deg: tuple = (20.0, 40.0)
+    speed_quantiles: tuple = (0.5, 0.9)
+    dba_window_s: float = 2.0
+    lesion_side: str = "left"
+
+    def __post_init__(self):
+        def put(name, value):
+            object.__setattr__(self, name, value)
+
+        def name(f):
+            return f"FeatureConfig.{f}"
+
+        if not isinstance(self.method, str):
+            raise ValueError(f"{name('method')} must be a string, got {self.method!r}")
+        try:
+            m = _filters.get_method(self.method)
+        except ValueError as exc:
+            raise ValueError(f"{name('method')}: {exc}") from None
+        if not isinstance(self.method_params, dict):
+            raise ValueError(
+                f"{name('method_params')} must be a dict, got {self.method_params!r}"
+            )
+        try:
+            resolved = m.resolve(dict(self.method_params))
+        except ValueError as exc:
+            raise ValueError(f"{name('method_params')}: {exc}") from None
+        defaults = m.defaults
+
+        def typed(k, v):
+            # a numeric parameter must be a finite number; 2 and 2.0 are the same
+            # cut-off: one spelling, one hash
+            d = defaults.get(k)
+            if isinstance(d, (int, float)) and not isinstance(d, bool):
+                x = _v.finite(v, f"{name('method_params')}[{k!r}]")
+                return float(x) if isinstance(d, float) else _plain(v)
+            return _plain(v)
+
+        resolved = {k: typed(k, resolved[k]) for k in sorted(resolved)}
+        try:
+            json.dumps(resolved, allow_nan=False)
+        except (TypeError, ValueError):
+            raise ValueError(
+                f"{name('method_params')} must hold JSON-serialisable values, got "
+                f"{self.method_params!r}"
+            ) from None
+        put("method_params", resolved)
+        for f in ("use_mag", "calibration_gyro", "auto_threshold"):
+            v = getattr(self, f)
+            if not isinstance(v, (bool, np.bool_)):
+                raise ValueError(f"{name(f)} must be True or False, got {v!r}")
+            put(f, bool(v))
+        if self.use_mag and not m.supports_mag:
+            raise ValueError(
+                f"{name('use_mag')}: method {self.method!r} does not use a magnetometer"
+            )
+        choices = {
+            "calibration_model": ("offsets", "ellipsoid"),
+            "gyr_offset": ("auto", "none"),
+            "lesion_side": ("left", "right"),
+        }
+        for f, allowed in choices.items():
+            if getattr(self, f) not in allowed:
+                raise ValueError(
+                    f"{name(f)} must be one of {allowed}, got {getattr(self, f)!r}"
+                )
+        put(
+            "threshold_deg_s",
+            _v.positive(self.threshold_deg_s, name("threshold_deg_s")),
+        )
+        put("merge_gap_s", _v.nonnegative(self.merge_gap_s, name("merge_gap_s")))
+        put(
+            "min_duration_s",
+            _v.nonnegative(self.min_duration_s, name("min_duration_s")),
+        )
+        put("mesh_n", _v.integer(self.mesh_n, name("mesh_n"), minimum=12))
+        put(
+            "visited_min_count",
+            _v.integer(self.visited_min_count, name("visited_min_count"), minimum=1),
+        )
+        put("dba_window_s", _v.positive(self.dba_window_s, name("dba_window_s")))
+        thr = self._floats("tilt_thresholds_deg")
+        if any(not 0 < t < 180 for t in thr):
+            raise ValueError(
+                f"{name('tilt_thresholds_deg')} must be angles in (0, 180) deg, got "
+                f"{self.tilt_thresholds_deg!r}"
+            )
+        put("tilt_thresholds_deg", thr)
+        qs = self._floats("speed_quantiles")
+        for q in qs:
+            _v.fraction(q, name("speed_quantiles"))
+        put("speed_quantiles", qs)
+
+    def _floats(self, f: str) -> tuple[float, ...]:
+        v = getattr(self, f)
+        vals = (v,) if np.isscalar(v) else tuple(v)
+        out = tuple(_v.finite(x, f"FeatureConfig.{f}") for x in vals)
+        if len(set(out)) != len(out):
+            raise ValueError(f"FeatureConfig.{f} has repeated values: {v!r}")
+        return tuple(sorted(out))
+
+    # ------------------------------------------------------------ serialisation
+
+    def to_dict(self) -> dict[str, Any]:
+        """Every field as JSON-compatible values (round trip with :meth:`from_dict`)."""
+        return {f.name: _plain(getattr(self, f.name)) for f in fields(self)}
+
+    @classmethod
+    def from_dict(cls, d: dict[str, Any]) -> "FeatureConfig":
+        """A configuration from :meth:`to_dict` output; an unknown key is a ValueError."""
+        if not isinstance(d, dict):
+            raise ValueError(f"expected a dict, got {type(d).__name__}")
+        names = {f.name for f in fields(cls)}
+        unknown = sorted(set(d) - names)
+        if unknown:
+            raise ValueError(
+                f"unknown FeatureConfig field(s) {unknown}; known: {sorted(names)}"
+            )
+        kw = dict(d)
+        for f in ("tilt_thresholds_deg", "speed_quantiles"):
+            if f in kw and isinstance(kw[f], list):
+                kw[f] = tuple(kw[f])
+        return cls(**kw)
+
+    def to_json(self) -> str:
+        """Canonical JSON (sorted keys, no whitespace): the input of :meth:`hash`."""
+        return json.dumps(
+            self.to_dict(), sort_keys=True, separators=(",", ":"), allow_nan=False
+        )
+
+    @classmethod
+    def from_json(cls, text: str) -> "FeatureConfig":
+        """Inverse of :meth:`to_json`."""
+        return cls.from_dict(json.loads(text))
+
+    def hash(self) -> str:
+        """SHA-256 (hex) of :meth:`to_json`: equal configurations, equal hashes."""
+        return hashlib.sha256(self.to_json().encode()).hexdigest()
+
+    def __hash__(self) -> int:
+        return int(self.hash()[:16], 16)

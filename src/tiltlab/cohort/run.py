@@ -1,0 +1,455 @@
+r"""Run a cohort: one task per session on any scheduler, a disk cache, no lost sessions.
+
+:func:`run_cohort` submits one task per session that is not in the cache and collects
+the results as they complete, through the same two calls (``submit``, then
+``as_completed``) whatever runs them: this process (serial), a local process pool, or a
+``dask.distributed`` cluster. Every result is written to the cache as soon as it
+arrives, atomically (a temporary file renamed into place), so a killed run leaves no
+corrupt entry and a restarted run resumes where it stopped. A session that cannot be
+read or computed becomes a row with ``status = "failed"``, its ``error`` and NaN
+features; the others complete.
+
+References
+----------
+.. [1] R. Fayat et al., "Inertial Measurement of Head Tilt in Rodents: Principles and
+   Applications to Vestibular Research", Sensors 21(18):6318, 2021.
+   doi:10.3390/s21186318
+"""
+
+from __future__ import annotations
+
+import functools
+import hashlib
+import json
+import os
+import sys
+import uuid
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+import xarray as xr
+
+from .. import __version__
+from .. import io as _io
+from .config import FeatureConfig
+from .features import feature_specs, session_features
+from .manifest import (
+    Manifest,
+    load_calibration,
+    load_session,
+    read_manifest,
+    session_path,
+)
+from .schedulers import backend as _backend
+
+__all__ = [
+    "CohortSummary",
+    "run_cohort",
+    "summary",
+    "save_features",
+    "load_features",
+    "compute_session",
+    "cache_key",
+]
+
+#: bump when the feature computation changes in a way the config hash cannot see
+CACHE_VERSION = 1
+DEFAULT_CACHE = ".tiltlab-cache"
+
+
+# ------------------------------------------------------------------ one session
+
+
+@functools.lru_cache(maxsize=8)
+def _calibration_file(path: str, size: int, mtime_ns: int) -> xr.Dataset | None:
+    # a subject's tumble test serves all its sessions: read it once per process
+    return load_calibration({"calibration": path}, "/")
+
+
+def _calibration_of(row: dict, root: str) -> xr.Dataset | None:
+    cal = str(row.get("calibration", "") or "")
+    if not cal:
+        return None
+    path = session_path(cal, root)
+    if not path.is_file():
+        return load_calibration(row, root)  # raises the reader's error
+    st = path.stat()
+    return _calibration_file(str(path.resolve()), st.st_size, st.st_mtime_ns)
+
+
+def compute_session(row: dict, root: str, config: FeatureConfig) -> dict[str, Any]:
+    """Load one session (and its calibration) and compute its features; never raises.
+
+    Returns ``{"session", "status", "error", "features"}``: ``status`` is ``"ok"``
+    with the feature Dataset, or ``"failed"`` with ``error`` = ``"<Type>: <message>"``
+    and ``features`` None. This is the task :func:`run_cohort` submits.
+    """
+    try:
+        rec = load_session(row, root)
+        cal = _calibration_of(row, root)
+        ds = session_features(rec, config, calibration=cal)
+    except Exception as exc:  # any failure is recorded, never propagated
+        msg = " ".join(str(exc).split())
+        return {
+            "session": row["session"],
+            "status": "failed",
+            "error": f"{type(exc).__name__}: {msg}",
+            "features": None,
+        }
+    return {"session": row["session"], "status": "ok", "error": "", "features": ds}
+
+
+# ------------------------------------------------------------------ cache
+
+
+def _sha256(path: Path) -> str | None:
+    try:
+        h = hashlib.sha256()
+        with open(path, "rb") as f:
+            for chunk in iter(lambda: f.read(1 << 20), b""):
+                h.update(chunk)
+        return h.hexdigest()
+    except OSError:
+        return None
+
+
+def _options_of(row) -> dict:
+    opts = row.get("reader_options") or {}
+    return dict(opts) if isinstance(opts, dict) else json.loads(opts)
+
+
+def cache_key(
+    row: dict, root, config: FeatureConfig, *, digests: dict | None = None
+) -> str | None:
+    """The cache key of a session: SHA-256 over its file's bytes, its calibration
+    file's bytes, the reader and its options, the configuration's hash and the package
+    version. None when a file cannot be read (such a session is always recomputed).
+    ``digests`` (path → SHA-256) memoises file digests over one run (a subject's
+    calibration file serves several sessions)."""
+    memo = {} if digests is None else digests
+
+    def digest(f) -> str | None:
+        p = str(session_path(f, root))
+        if p not in memo:
+            memo[p] = _sha256(Path(p))
+        return memo[p]
+
+    parts = {
+        "file": digest(row["file"]),
+        "reader": row["reader"],
+        "reader_options": _options_of(row),
+        "config": config.hash(),
+        "version": [CACHE_VERSION, __version__],
+    }
+    if parts["file"] is None:
+        return None
+    cal = str(row.get("calibration", "") or "")
+    if cal:
+        parts["calibration"] = digest(cal)
+        if parts["calibration"] is None:
+            return None
+    blob = json.dumps(parts, sort_keys=True, separators=(",", ":"))
+    return hashlib.sha256(blob.encode()).hexdigest()
+
+
+def _cache_get(cache: Path, key: str | None, names) -> xr.Dataset | None:
+    if key is None:
+        return None
+    path = cache / f"{key}.json"
+    try:
+        entry = json.loads(path.read_text())
+        ds = xr.Dataset(
+            {
+                k: ((), np.float64(entry["values"][k]), entry["var_attrs"][k])
+                for k in names
+            },
+            attrs=entry["attrs"],
+        )
+    except (OSError, ValueError, KeyError, TypeError):
+        return None  # absent or unreadable: a miss (the entry is rewritten)
+    return ds
+
+
+def _atomic_write(text: str, path: Path) -> Path:
+    """Write ``text`` to a temporary file beside ``path``, then rename it into place."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_name(f".{path.name}.{os.getpid()}.{uuid.uuid4().hex}.tmp")
+    try:
+        with open(tmp, "w") as f:
+            f.write(text)
+            f.flush()
+            os.fsync(f.fileno())
+        os.replace(tmp, path)
+    finally:
+        if tmp.exists():
+            tmp.unlink()
+    return path
+
+
+def _cache_put(cache: Path, key: str, ds: xr.Dataset) -> Path:
+    # scalars as JSON: exact float64 round trip (repr), much faster than NetCDF
+    entry = {
+        "values": {k: float(v.values) for k, v in ds.data_vars.items()},
+        "var_attrs": {k: dict(v.attrs) for k, v in ds.data_vars.items()},
+        "attrs": dict(ds.attrs),
+    }
+    return _atomic_write(json.dumps(entry, sort_keys=True), cache / f"{key}.json")
+
+
+# ------------------------------------------------------------------ the run
+
+
+def _assemble(
+    manifest: Manifest,
+    config: FeatureConfig,
+    results: dict[str, dict[str, Any]],
+    n_computed: int,
+    n_cached: int,
+) -> xr.Dataset:
+    table = manifest.table
+    spec = feature_specs(config)
+    n = len(table)
+    values = {k: np.full(n, np.nan) for k in spec}
+    status = np.empty(n, dtype=object)
+    error = np.empty(n, dtype=object)
+    for i, sid in enumerate(table["session"]):
+        r = results[sid]
+        status[i], error[i] = r["status"], r["error"]
+        if r["features"] is not None:
+            for k in spec:
+                values[k][i] = float(r["features"][k].values)
+    data = {
+        k: ("session", values[k], {"units": u, "long_name": ln})
+        for k, (u, ln) in spec.items()
+    }
+    data["status"] = ("session", status.astype(str), {"long_name": "ok or failed"})
+    data["error"] = (
+        "session",
+        error.astype(str),
+        {"long_name": "why the session failed (empty when ok)"},
+    )
+
+    def coord(col):
+        v = table[col]
+        arr = (
+            v.to_numpy()
+            if pd.api.types.is_numeric_dtype(v)
+            else v.astype(str).to_numpy()
+        )
+        return ("session", arr.astype(str) if arr.dtype == object else arr)
+
+    coords = {"session": table["session"].astype(str).to_numpy()}
+    for c in ["subject", "group", "timepoint", "file", "reader"] + manifest.covariates:
+        coords[c] = coord(c)
+    n_failed = int(np.sum(status == "failed"))
+    attrs = {
+        "title": "tiltlab cohort features",
+        "feature_config": config.to_json(),
+        "config_hash": config.hash(),
+        "tiltlab_version": __version__,
+        "manifest": str(manifest.path) if manifest.path else "",
+        "n_sessions": n,
+        "n_ok": n - n_failed,
+        "n_failed": n_failed,
+        "n_computed": n_computed,
+        "n_cached": n_cached,
+        "references": "R. Fayat et al., Sensors 21(18):6318, 2021. doi:10.3390/s21186318",
+    }
+    return xr.Dataset(data, coords=coords, attrs=attrs)
+
+
+def run_cohort(
+    manifest,
+    config: FeatureConfig | None = None,
+    *,
+    scheduler=None,
+    workers: int | None = None,
+    cache_dir=None,
+    progress: bool = True,
+    out=None,
+) -> xr.Dataset:
+    r"""Compute every session's features and gather them in one Dataset.
+
+    Parameters
+    ----------
+    manifest : Manifest or path-like
+        A manifest (:func:`~tiltlab.cohort.read_manifest`) or its CSV file.
+    config : FeatureConfig, optional
+        Feature configuration (default :class:`FeatureConfig()`).
+    scheduler : None, "processes", "dask", str or distributed.Client
+        Where the sessions run: ``None`` serially in this process (a local process pool
+        when ``workers > 1``), ``"processes"`` a local process pool of ``workers``,
+        ``"dask"`` a ``distributed.LocalCluster(n_workers=workers,
+        threads_per_worker=1)`` started and closed here, an address ``"tcp://…"`` an
+        existing scheduler, or a ``distributed.Client`` (left open). The same tasks are
+        submitted in every case and give identical features.
+    workers : int, optional
+        Number of worker processes.
+    cache_dir : path-like, optional
+        Per-session cache (default ``.tiltlab-cache`` beside the manifest). Entries are
+        keyed by :func:`cache_key`: a rerun recomputes only sessions whose file,
+        calibration file, reader options or configuration changed, and sessions that
+        failed.
+    progress : bool
+        Show a tqdm progress bar of sessions done, and print the summary at the end.
+    out : path-like, optional
+        Also save the Dataset there (:func:`save_features`).
+
+    Returns
+    -------
+    xarray.Dataset
+        Dimension ``session``; the features of :func:`~tiltlab.cohort.session_features`
+        (NaN for failed sessions), ``status`` ("ok"/"failed") and ``error``;
+        coordinates ``subject``, ``group``, ``timepoint``, ``file``, ``reader`` and the
+        covariates; attrs ``feature_config`` (JSON), ``config_hash``, ``n_sessions``,
+        ``n_ok``, ``n_failed``, ``n_computed`` (sessions computed in this run,
+        failed ones included) and ``n_cached`` (taken from the cache).
+
+    Notes
+    -----
+    Feature definitions follow Fayat et al. §2.7–2.10 (see
+    :func:`~tiltlab.cohort.session_features`). The run never raises for a bad session;
+    read the outcome with :func:`summary`.
+
+    References
+    ----------
+    .. [1] R. Fayat et al., Sensors 21(18):6318, 2021. doi:10.3390/s21186318
+    """
+    from tqdm import tqdm
+
+    if not isinstance(manifest, Manifest):
+        manifest = read_manifest(manifest)
+    config = config or FeatureConfig()
+    if not isinstance(config, FeatureConfig):
+        raise TypeError(f"config must be a FeatureConfig, got {type(config).__name__}")
+    root = str(manifest.root)
+    cache = Path(cache_dir) if cache_dir is not None else manifest.root / DEFAULT_CACHE
+    rows = list(manifest.rows())
+    spec = feature_specs(config)
+    results: dict[str, dict[str, Any]] = {}
+    keys: dict[str, str | None] = {}
+    digests: dict[str, str | None] = {}
+    todo = []
+    for row in rows:
+        key = cache_key(row, root, config, digests=digests)
+        keys[row["session"]] = key
+        hit = _cache_get(cache, key, spec)
+        if hit is not None:
+            results[row["session"]] = {
+                "status": "ok",
+                "error": "",
+                "features": hit,
+            }
+        else:
+            todo.append(row)
+    n_cached = len(results)
+    bar = tqdm(
+        total=len(rows),
+        initial=n_cached,
+        desc="sessions",
+        unit="session",
+        disable=not progress,
+    )
+    if todo:
+        backend = _backend(scheduler, workers)
+        try:
+            futures = {
+                backend.submit(compute_session, row, root, config): row["session"]
+                for row in todo
+            }
+            for fut in backend.as_completed(list(futures)):
+                sid = futures[fut]
+                try:
+                    res = fut.result()
+                except Exception as exc:  # the worker itself died
+                    res = {
+                        "status": "failed",
+                        "error": f"{type(exc).__name__}: {exc}",
+                        "features": None,
+                    }
+                if res["status"] == "ok" and keys[sid] is not None:
+                    _cache_put(cache, keys[sid], res["features"])
+                results[sid] = res
+                bar.update()
+        finally:
+            backend.close()
+    bar.close()
+    ds = _assemble(manifest, config, results, len(todo), n_cached)
+    if out is not None:
+        save_features(ds, out)
+    if progress:
+        print(summary(ds), file=sys.stderr)
+    return ds
+
+
+# ------------------------------------------------------------------ summary, files
+
+
+@dataclass(frozen=True)
+class CohortSummary:
+    """Outcome of a cohort run: counts and, per failed session, the reason."""
+
+    n_sessions: int
+    n_ok: int
+    n_failed: int
+    n_computed: int | None = None
+    n_cached: int | None = None
+    failures: dict[str, str] = field(default_factory=dict)
+
+    def __str__(self) -> str:
+        head = f"{self.n_sessions} sessions: {self.n_ok} ok, {self.n_failed} failed"
+        if self.n_computed is not None:
+            head += f" ({self.n_computed} computed, {self.n_cached} from cache)"
+        lines = [head] + [f"  failed {s}: {e}" for s, e in self.failures.items()]
+        return "\n".join(lines)
+
+
+def summary(features: xr.Dataset) -> CohortSummary:
+    """Counts of ok and failed sessions, and why each failed, of a cohort Dataset."""
+    if "status" not in features or "session" not in features.dims:
+        raise ValueError("not a cohort feature table (no 'status' along 'session')")
+    status = features["status"].values.astype(str)
+    err = features["error"].values.astype(str)
+    sessions = features["session"].values.astype(str)
+    failed = status == "failed"
+
+    def attr(k):
+        v = features.attrs.get(k)
+        return None if v is None else int(v)
+
+    return CohortSummary(
+        n_sessions=int(status.size),
+        n_ok=int(np.sum(status == "ok")),
+        n_failed=int(failed.sum()),
+        n_computed=attr("n_computed"),
+        n_cached=attr("n_cached"),
+        failures={s: e for s, e, f in zip(sessions, err, failed) if f},
+    )
+
+
+def save_features(ds: xr.Dataset, path) -> Path:
+    """Save a feature table to NetCDF (exact round trip with :func:`load_features`),
+    atomically."""
+    if not isinstance(ds, xr.Dataset):
+        raise TypeError(f"expected an xarray.Dataset, got {type(ds).__name__}")
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_name(f".{path.name}.{os.getpid()}.{uuid.uuid4().hex}.tmp")
+    try:
+        _io.save_netcdf(ds, tmp)
+        os.replace(tmp, path)
+    finally:
+        if tmp.exists():
+            tmp.unlink()
+    return path
+
+
+def load_features(path) -> xr.Dataset:
+    """Load a feature table written by :func:`save_features` (or :func:`run_cohort`)."""
+    ds = _io.load_netcdf(path)
+    if "session" not in ds.dims:
+        raise ValueError(f"{path}: not a cohort feature table (no 'session' dimension)")
+    return ds

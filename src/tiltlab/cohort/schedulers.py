@@ -1,0 +1,137 @@
+"""Schedulers for :func:`tiltlab.cohort.run_cohort`: one interface, three back ends.
+
+Every back end offers ``submit(fn, *args)`` → a future with ``result()``,
+``as_completed(futures)`` → the futures in completion order, and ``close()``:
+
+* serial — tasks run in this process, one by one, when collected;
+* processes — a :class:`concurrent.futures.ProcessPoolExecutor` whose workers are
+  started with ``spawn`` (a script that runs a cohort on processes therefore needs the
+  usual ``if __name__ == "__main__":`` guard);
+* dask — a ``dask.distributed`` client: a ``LocalCluster`` started here
+  (``"dask"``), an existing scheduler (an address ``"tcp://…"``) or a given
+  ``distributed.Client``.
+
+:func:`run_cohort` uses only these three calls, so a session's task is the same
+whatever runs it.
+"""
+
+from __future__ import annotations
+
+import multiprocessing
+import os
+import uuid
+from collections.abc import Callable, Iterable, Iterator
+from concurrent.futures import Future, ProcessPoolExecutor
+from concurrent.futures import as_completed as _cf_as_completed
+
+__all__ = ["backend"]
+
+
+class _Lazy:
+    """A task run when its result is first asked for (serial scheduler)."""
+
+    def __init__(self, fn: Callable, args: tuple):
+        self.fn, self.args, self._done, self._value = fn, args, False, None
+
+    def result(self):
+        if not self._done:
+            self._value, self._done = self.fn(*self.args), True
+        return self._value
+
+
+class _Serial:
+    name = "serial"
+
+    def submit(self, fn, *args):
+        return _Lazy(fn, args)
+
+    def as_completed(self, futures: Iterable) -> Iterator:
+        for f in futures:
+            f.result()
+            yield f
+
+    def close(self):
+        pass
+
+
+class _Processes:
+    name = "processes"
+
+    def __init__(self, workers: int):
+        # spawn, not fork: numba's OpenMP threads make fork() unsafe once a kernel ran
+        self.pool = ProcessPoolExecutor(
+            max_workers=workers, mp_context=multiprocessing.get_context("spawn")
+        )
+
+    def submit(self, fn, *args) -> Future:
+        return self.pool.submit(fn, *args)
+
+    def as_completed(self, futures):
+        return _cf_as_completed(futures)
+
+    def close(self):
+        self.pool.shutdown(wait=True, cancel_futures=True)
+
+
+class _Dask:
+    name = "dask"
+
+    def __init__(self, scheduler, workers: int | None):
+        from distributed import Client, LocalCluster
+
+        self.cluster = None
+        self.own_client = True
+        if isinstance(scheduler, Client):
+            self.client, self.own_client = scheduler, False
+        elif scheduler == "dask":
+            self.cluster = LocalCluster(
+                n_workers=int(workers or os.cpu_count() or 1),
+                threads_per_worker=1,
+                processes=True,
+                dashboard_address=":0",  # any free port: never clash with another
+            )
+            self.client = Client(self.cluster)
+        else:
+            self.client = Client(scheduler)
+
+    def submit(self, fn, *args):
+        return self.client.submit(
+            fn, *args, pure=False, key=f"tiltlab-session-{uuid.uuid4().hex}"
+        )
+
+    def as_completed(self, futures):
+        from distributed import as_completed
+
+        return as_completed(list(futures))
+
+    def close(self):
+        if self.own_client:
+            self.client.close()
+        if self.cluster is not None:
+            self.cluster.close()
+
+
+def backend(scheduler, workers: int | None):
+    """The back end for a ``scheduler`` argument of :func:`run_cohort` (see there)."""
+    if workers is not None and (isinstance(workers, bool) or int(workers) != workers):
+        raise ValueError(f"workers must be a positive integer, got {workers!r}")
+    if workers is not None and workers < 1:
+        raise ValueError(f"workers must be at least 1, got {workers!r}")
+    if scheduler is None:
+        if workers is not None and workers > 1:
+            return _Processes(int(workers))
+        return _Serial()
+    if scheduler == "processes":
+        return _Processes(int(workers or os.cpu_count() or 1))
+    if scheduler == "dask" or (isinstance(scheduler, str) and "://" in scheduler):
+        return _Dask(scheduler, workers)
+    try:
+        from distributed import Client
+    except ImportError:  # pragma: no cover - distributed is a dependency
+        Client = ()
+    if isinstance(scheduler, Client):
+        return _Dask(scheduler, workers)
+    raise ValueError(
+        "scheduler must be None, 'processes', 'dask', a scheduler address "
+        f"'tcp://host:port' or a distributed.Client, got {scheduler!r}"
+    )
