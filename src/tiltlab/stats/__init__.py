@@ -1,0 +1,108 @@
+r"""Group statistics of cohort features (layer 7): rank tests between groups and against
+baseline, multiple-comparison adjustments (including Fayat et al.'s uncapped
+Bonferroni convention), effect sizes with confidence intervals, a longitudinal mixed
+model, and power by simulation.
+
+One implementation each:
+
+* :mod:`~tiltlab.stats.nonparametric` — :func:`mann_whitney`,
+  :func:`wilcoxon_signed_rank` (exact, exact conditional with ties/zeros, or
+  asymptotic, the method recorded), the exact p-value lattices;
+* :mod:`~tiltlab.stats.multiple` — :func:`adjust`, :func:`paper_bonferroni`,
+  :data:`FAYAT_FAMILIES` (18 between groups, 6 against baseline);
+* :mod:`~tiltlab.stats.effects` — rank-biserial correlation, probability of
+  superiority, Hodges–Lehmann shift with its exact distribution-free interval;
+* :mod:`~tiltlab.stats.mixed` — :func:`mixed_model` (MixedLM with convergence checks);
+* :mod:`~tiltlab.stats.power` — :func:`power_by_simulation`, :func:`animals_needed`
+  for a user-supplied simulator (this package never imports :mod:`tiltlab.simulate`);
+* :mod:`~tiltlab.stats.tables` — :func:`between_groups`, :func:`against_baseline`
+  (tidy tables from a cohort Dataset/DataFrame) and :func:`format_table` (Tables
+  A1–A8 layout).
+
+Example
+-------
+>>> import tiltlab.stats as S
+>>> float(6 * S.signed_rank_p_lattice(5)['p'].iloc[0])  # Fayat Table A2: 0.188
+0.1875
+"""
+
+from .effects import (
+    Interval,
+    hodges_lehmann,
+    paired_prob_superiority,
+    paired_rank_biserial,
+    prob_superiority,
+    rank_biserial,
+)
+from .mixed import MixedModelResult, mixed_model
+from .multiple import (
+    ADJUSTMENTS,
+    FAYAT_FAMILIES,
+    add_adjustments,
+    adjust,
+    paper_bonferroni,
+)
+from .nonparametric import (
+    ALTERNATIVES,
+    ZERO_METHODS,
+    TestResult,
+    exact_p_lattice,
+    mann_whitney,
+    mwu_null_distribution,
+    signed_rank_null_distribution,
+    signed_rank_p_lattice,
+    wilcoxon_signed_rank,
+)
+from .power import (
+    PowerResult,
+    animals_needed,
+    noether_n_per_group,
+    normal_shift,
+    normal_shift_superiority,
+    power_by_simulation,
+)
+from .tables import (
+    COLOURS,
+    THRESHOLDS,
+    against_baseline,
+    between_groups,
+    format_table,
+    long_table,
+)
+
+__all__ = [
+    "ALTERNATIVES",
+    "ZERO_METHODS",
+    "TestResult",
+    "mann_whitney",
+    "wilcoxon_signed_rank",
+    "mwu_null_distribution",
+    "signed_rank_null_distribution",
+    "exact_p_lattice",
+    "signed_rank_p_lattice",
+    "ADJUSTMENTS",
+    "FAYAT_FAMILIES",
+    "adjust",
+    "paper_bonferroni",
+    "add_adjustments",
+    "Interval",
+    "hodges_lehmann",
+    "prob_superiority",
+    "rank_biserial",
+    "paired_rank_biserial",
+    "paired_prob_superiority",
+    "MixedModelResult",
+    "mixed_model",
+    "PowerResult",
+    "normal_shift",
+    "normal_shift_superiority",
+    "noether_n_per_group",
+    "power_by_simulation",
+    "animals_needed",
+    "THRESHOLDS",
+    "COLOURS",
+    "long_table",
+    "between_groups",
+    "against_baseline",
+    "format_table",
+]

@@ -1,0 +1,499 @@
+r"""Cohort glue and tables: the tests of every comparison × time point, tidy, and laid
+out like Fayat et al.'s Tables A1–A8.
+
+Input is the cohort table of :func:`tiltlab.cohort.run_cohort` — an
+:class:`xarray.Dataset` with a ``session`` dimension, coordinates ``subject``,
+``group``, ``timepoint`` and one variable per feature (sessions whose ``status`` is
+not ``"ok"`` are skipped) — or a :class:`pandas.DataFrame` with those columns.
+Missing feature values are dropped per cell and counted in ``n_missing``.
+
+Tidy columns (one row per comparison × time point)
+-------------------------------------------------
+``feature, comparison, group1, group2, timepoint, test, n1, n2, n_missing, statistic,
+alternative, method, p, family_size, p_paper, p_bonferroni, p_holm, p_bh, rbc,
+rbc_low, rbc_high, ps, ps_low, ps_high, hl, hl_low, hl_high, hl_achieved, conf_level,
+note``
+
+* ``alternative`` states the direction: ``"greater"`` means ``group1`` (or the time
+  point, against baseline) tends to be larger.
+* ``p_paper`` is Fayat et al.'s Bonferroni convention (:math:`m p`, uncapped,
+  :math:`m` = ``family_size``); ``p_bonferroni``, ``p_holm``, ``p_bh`` are the capped
+  statsmodels adjustments over the same family (:mod:`tiltlab.stats.multiple`).
+* Effect sizes (:mod:`tiltlab.stats.effects`): between groups, ``rbc`` and ``ps`` are
+  the rank-biserial correlation and :math:`P(X_1 > X_2) + \frac12 P(=)`, ``hl`` the
+  Hodges–Lehmann shift ``group1 - group2``; against baseline, ``rbc`` is the
+  matched-pairs rank-biserial correlation (no interval), ``ps`` is
+  :math:`P(D > 0) + \frac12 P(D = 0)` and ``hl`` the pseudo-median of the differences
+  (time point − baseline). Intervals are two-sided at ``conf_level``.
+* A cell that cannot be tested (a group without enough values) keeps NaN values and
+  says why in ``note``.
+
+References
+----------
+.. [1] R. Fayat et al., Sensors 21(18):6318, 2021, Appendix A.7.
+   doi:10.3390/s21186318
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Mapping, Sequence
+
+import numpy as np
+import pandas as pd
+import xarray as xr
+
+from .. import _validate
+from .effects import (
+    hodges_lehmann,
+    paired_prob_superiority,
+    paired_rank_biserial,
+    prob_superiority,
+)
+from .multiple import add_adjustments
+from .nonparametric import _alternative, mann_whitney, wilcoxon_signed_rank
+
+__all__ = [
+    "long_table",
+    "between_groups",
+    "against_baseline",
+    "format_table",
+    "THRESHOLDS",
+    "COLOURS",
+]
+
+#: Highlight thresholds of Tables A1–A8 and their colours (yellow, green, blue).
+THRESHOLDS = (0.05, 0.01, 0.001)
+COLOURS = ("#fff176", "#a5d6a7", "#90caf9")
+
+_DURATION = re.compile(r"^\s*([-+]?\d+(?:\.\d+)?)\s*(min|h|d|w)\s*$", re.IGNORECASE)
+_UNIT_HOURS = {"min": 1 / 60, "h": 1.0, "d": 24.0, "w": 168.0}
+
+
+def long_table(features, feature: str) -> pd.DataFrame:
+    """One row per usable session: ``subject``, ``group``, ``timepoint``, ``value``.
+
+    Parameters
+    ----------
+    features : xarray.Dataset or pandas.DataFrame
+        The cohort table (see the module docstring).
+    feature : str
+        The feature variable / column.
+
+    Returns
+    -------
+    pandas.DataFrame
+        Sessions with ``status == "ok"`` (when a status exists); ``value`` may be NaN.
+    """
+    need = ("subject", "group", "timepoint")
+    if isinstance(features, xr.Dataset):
+        if "session" not in features.dims:
+            raise ValueError("features must have a 'session' dimension")
+        if feature not in features.data_vars:
+            raise ValueError(
+                f"feature {feature!r} is not a variable of features "
+                f"(variables: {sorted(map(str, features.data_vars))})"
+            )
+        if features[feature].dims != ("session",):
+            raise ValueError(f"feature {feature!r} must have dims ('session',)")
+        missing = [c for c in need if c not in features.variables]
+        if missing:
+            raise ValueError(f"features lacks coordinate(s) {missing}")
+        cols = {c: features[c].values for c in need}
+        cols["value"] = features[feature].values
+        if "status" in features.variables:
+            cols["status"] = features["status"].values
+        df = pd.DataFrame(cols)
+    elif isinstance(features, pd.DataFrame):
+        missing = [c for c in (*need, feature) if c not in features.columns]
+        if missing:
+            raise ValueError(f"features lacks column(s) {missing}")
+        keep = list(need) + (["status"] if "status" in features.columns else [])
+        df = features[keep].copy()
+        df["value"] = features[feature].to_numpy()
+    else:
+        raise ValueError(
+            f"features must be an xarray.Dataset or a pandas.DataFrame, got "
+            f"{type(features).__name__}"
+        )
+    if "status" in df.columns:
+        df = df[df["status"].astype(str) == "ok"].drop(columns="status")
+    df["value"] = pd.to_numeric(df["value"], errors="coerce").astype(float)
+    return df.reset_index(drop=True)
+
+
+def _timepoint_key(label) -> float:
+    if isinstance(label, (int, float, np.integer, np.floating)):
+        return float(label) * 24.0  # numbers are days
+    m = _DURATION.match(str(label))
+    if m:
+        return float(m.group(1)) * _UNIT_HOURS[m.group(2).lower()]
+    raise KeyError(label)
+
+
+def _ordered_timepoints(df: pd.DataFrame, baseline, timepoints) -> list:
+    present = list(dict.fromkeys(df["timepoint"]))
+    if timepoints is not None:
+        unknown = [t for t in timepoints if t not in present]
+        if unknown:
+            raise ValueError(f"timepoints {unknown} are not in the data ({present})")
+        return list(timepoints)
+    rest = [t for t in present if t != baseline]
+    try:
+        rest.sort(key=_timepoint_key)
+    except KeyError:
+        pass  # keep the order of appearance
+    return rest
+
+
+def _effects_row(x, y, conf_level, paired, zero_method="wilcox") -> dict:
+    if paired:
+        ps = paired_prob_superiority(x, y, conf_level=conf_level)
+        rbc_est = paired_rank_biserial(x, y, zero_method=zero_method)
+        rbc = (rbc_est, np.nan, np.nan)
+    else:
+        ps = prob_superiority(x, y, conf_level=conf_level)
+        rbc = (2 * ps.estimate - 1, 2 * ps.low - 1, 2 * ps.high - 1)
+    hl = hodges_lehmann(x, y, paired=paired, conf_level=conf_level)
+    return {
+        "rbc": rbc[0],
+        "rbc_low": rbc[1],
+        "rbc_high": rbc[2],
+        "ps": ps.estimate,
+        "ps_low": ps.low,
+        "ps_high": ps.high,
+        "hl": hl.estimate,
+        "hl_low": hl.low,
+        "hl_high": hl.high,
+        "hl_achieved": hl.achieved,
+    }
+
+
+_COLUMNS = (
+    "feature comparison group1 group2 timepoint test n1 n2 n_missing statistic "
+    "alternative method p rbc rbc_low rbc_high ps ps_low ps_high hl hl_low hl_high "
+    "hl_achieved conf_level note"
+).split()
+
+
+def _finish(rows: list[dict], family) -> pd.DataFrame:
+    table = pd.DataFrame(rows)
+    for c in _COLUMNS:
+        if c not in table.columns:
+            table[c] = np.nan
+    table = add_adjustments(table[_COLUMNS], family)
+    front = _COLUMNS[: _COLUMNS.index("p") + 1]
+    adj = ["family_size", "p_paper", "p_bonferroni", "p_holm", "p_bh"]
+    return table[front + adj + _COLUMNS[len(front) :]]
+
+
+def between_groups(
+    features,
+    feature: str,
+    comparisons: Sequence[tuple],
+    *,
+    alternative: str | None = None,
+    timepoints: Sequence | None = None,
+    baseline: str = "baseline",
+    family: int | str | Sequence[str] | None = None,
+    conf_level: float = 0.95,
+    method: str = "auto",
+    exact_max_n: int = 8,
+) -> pd.DataFrame:
+    r"""One-sided Mann–Whitney tests between groups at each time point.
+
+    Parameters
+    ----------
+    features : xarray.Dataset or pandas.DataFrame
+        Cohort table (see the module docstring).
+    feature : str
+        Feature to compare.
+    comparisons : sequence of tuples
+        ``(group1, group2, alternative)``, e.g. ``("Arsanilate", "Healthy",
+        "greater")`` — group1 tends to be larger — or ``(group1, group2)`` with the
+        ``alternative`` keyword.
+    alternative : {"greater", "less", "two-sided"}, optional
+        Direction for 2-tuples; no default — every direction must be stated.
+    timepoints : sequence, optional
+        Time points (columns) in order; default every time point except ``baseline``,
+        sorted by duration when the labels read as ``1h``, ``7d``… (else as found).
+    baseline : str
+        The baseline label excluded by default.
+    family : int, str, sequence of str or None
+        Bonferroni family (:func:`tiltlab.stats.multiple.add_adjustments`): default
+        every tested cell of the table, i.e. 18 for Fayat et al.'s 3 comparisons × 6
+        time points per lesion type.
+    conf_level : float
+        Level of the effect-size intervals.
+    method, exact_max_n
+        See :func:`tiltlab.stats.mann_whitney`.
+
+    Returns
+    -------
+    pandas.DataFrame
+        The tidy table, one row per comparison × time point.
+    """
+    conf_level = _validate.fraction(
+        conf_level, "conf_level", open_low=True, open_high=True
+    )
+    df = long_table(features, feature)
+    groups = set(df["group"])
+    specs = []
+    for comp in comparisons:
+        if not isinstance(comp, (tuple, list)) or len(comp) not in (2, 3):
+            raise ValueError(
+                "comparisons must be (group1, group2[, alternative]) tuples, got "
+                f"{comp!r}"
+            )
+        g1, g2 = comp[0], comp[1]
+        alt = comp[2] if len(comp) == 3 else alternative
+        if alt is None:
+            raise ValueError(
+                f"comparisons: no alternative for {comp!r}; give (g1, g2, alternative) "
+                "or the alternative keyword"
+            )
+        _alternative(alt, "alternative (in comparisons)")
+        for g in (g1, g2):
+            if g not in groups:
+                raise ValueError(
+                    f"comparisons names group {g!r}, absent from the data "
+                    f"(groups: {sorted(map(str, groups))})"
+                )
+        specs.append((g1, g2, alt))
+    if not specs:
+        raise ValueError("comparisons is empty")
+    tps = _ordered_timepoints(df, baseline, timepoints)
+    rows = []
+    for g1, g2, alt in specs:
+        for t in tps:
+            cell = df[df["timepoint"] == t]
+            x = cell.loc[cell["group"] == g1, "value"].to_numpy()
+            y = cell.loc[cell["group"] == g2, "value"].to_numpy()
+            miss = int(np.isnan(x).sum() + np.isnan(y).sum())
+            x, y = x[~np.isnan(x)], y[~np.isnan(y)]
+            row = {
+                "feature": feature,
+                "comparison": f"{g1} vs. {g2}",
+                "group1": g1,
+                "group2": g2,
+                "timepoint": t,
+                "test": "mann-whitney",
+                "n1": x.size,
+                "n2": y.size,
+                "n_missing": miss,
+                "alternative": alt,
+                "conf_level": conf_level,
+                "note": "",
+            }
+            try:
+                res = mann_whitney(
+                    x, y, alternative=alt, method=method, exact_max_n=exact_max_n
+                )
+            except ValueError as exc:
+                row["note"] = f"not tested: {exc}"
+                rows.append(row)
+                continue
+            row.update(statistic=res.statistic, method=res.method, p=res.p)
+            row.update(_effects_row(x, y, conf_level, paired=False))
+            rows.append(row)
+    return _finish(rows, family)
+
+
+def against_baseline(
+    features,
+    feature: str,
+    groups: Sequence[str] | None = None,
+    *,
+    baseline: str = "baseline",
+    alternative: str | Mapping[str, str],
+    timepoints: Sequence | None = None,
+    family: int | str | Sequence[str] | None = "group1",
+    zero_method: str = "wilcox",
+    conf_level: float = 0.95,
+    method: str = "auto",
+    exact_max_n: int = 50,
+) -> pd.DataFrame:
+    r"""One-sided Wilcoxon signed-rank tests of each time point against baseline.
+
+    Subjects are paired by ``subject``; those missing either session are left out of
+    that cell (``n_missing``).
+
+    Parameters
+    ----------
+    features : xarray.Dataset or pandas.DataFrame
+        Cohort table.
+    feature : str
+        Feature to test.
+    groups : sequence of str, optional
+        Groups (rows), default all in order of appearance.
+    baseline : str
+        Baseline time point label.
+    alternative : str or mapping group -> str
+        ``"greater"``: the time point's values exceed the baseline's. Required.
+    timepoints : sequence, optional
+        Time points (columns); default all but ``baseline``.
+    family : int, str, sequence of str or None
+        Bonferroni family: default ``"group1"`` — each group's time points, i.e.
+        Fayat et al.'s 6 (Tables A2, A4, A6, A8).
+    zero_method : {"wilcox", "pratt"}
+        Zero-difference rule (:func:`tiltlab.stats.wilcoxon_signed_rank`).
+    conf_level : float
+        Level of the effect-size intervals.
+    method, exact_max_n
+        See :func:`tiltlab.stats.wilcoxon_signed_rank`.
+
+    Returns
+    -------
+    pandas.DataFrame
+        The tidy table; ``comparison`` reads ``"<group> vs. <group> baseline"`` as in
+        the paper; ``n1 = n2`` = number of pairs.
+    """
+    conf_level = _validate.fraction(
+        conf_level, "conf_level", open_low=True, open_high=True
+    )
+    df = long_table(features, feature)
+    present = list(dict.fromkeys(df["group"]))
+    groups = present if groups is None else list(groups)
+    for g in groups:
+        if g not in present:
+            raise ValueError(f"groups names {g!r}, absent from the data ({present})")
+    if not groups:
+        raise ValueError("groups is empty")
+    if isinstance(alternative, Mapping):
+        alts = {g: alternative.get(g) for g in groups}
+        lacking = [g for g, a in alts.items() if a is None]
+        if lacking:
+            raise ValueError(f"alternative gives no direction for groups {lacking}")
+    else:
+        alts = dict.fromkeys(groups, alternative)
+    for a in alts.values():
+        _alternative(a)
+    if baseline not in set(df["timepoint"]):
+        raise ValueError(f"baseline {baseline!r} is not a time point of the data")
+    tps = _ordered_timepoints(df, baseline, timepoints)
+    rows = []
+    for g in groups:
+        sub = df[df["group"] == g]
+        dup = sub.duplicated(["subject", "timepoint"])
+        if dup.any():
+            first = sub[dup].iloc[0]
+            raise ValueError(
+                f"features has two sessions of subject {first['subject']!r} at "
+                f"{first['timepoint']!r}; cannot pair with the baseline"
+            )
+        wide = sub.pivot(index="subject", columns="timepoint", values="value")
+        for t in tps:
+            row = {
+                "feature": feature,
+                "comparison": f"{g} vs. {g} baseline",
+                "group1": g,
+                "group2": f"{g} baseline",
+                "timepoint": t,
+                "test": "wilcoxon",
+                "alternative": alts[g],
+                "conf_level": conf_level,
+                "note": "",
+            }
+            if t not in wide.columns or baseline not in wide.columns:
+                row.update(n1=0, n2=0, n_missing=len(wide), note="not tested: no data")
+                rows.append(row)
+                continue
+            pair = wide[[t, baseline]]
+            ok = pair.notna().all(axis=1)
+            x, y = pair.loc[ok, t].to_numpy(), pair.loc[ok, baseline].to_numpy()
+            row.update(n1=x.size, n2=x.size, n_missing=int((~ok).sum()))
+            try:
+                res = wilcoxon_signed_rank(
+                    x,
+                    y,
+                    alternative=alts[g],
+                    zero_method=zero_method,
+                    method=method,
+                    exact_max_n=exact_max_n,
+                )
+            except ValueError as exc:
+                row["note"] = f"not tested: {exc}"
+                rows.append(row)
+                continue
+            row.update(statistic=res.statistic, method=res.method, p=res.p)
+            if res.n_zero:
+                row["note"] = f"{res.n_zero} zero difference(s), rule {zero_method!r}"
+            row.update(
+                _effects_row(x, y, conf_level, paired=True, zero_method=zero_method)
+            )
+            rows.append(row)
+    return _finish(rows, family)
+
+
+def _stars(v: float) -> str:
+    return "*" * sum(v < t for t in THRESHOLDS) if np.isfinite(v) else ""
+
+
+def _fmt(v: float, decimals: int) -> str:
+    if not np.isfinite(v):
+        return ""
+    small = 10.0**-decimals
+    return f"<{small:.{decimals}f}" if v < small else f"{v:.{decimals}f}"
+
+
+def format_table(
+    tidy: pd.DataFrame,
+    value: str = "p_paper",
+    *,
+    output: str = "text",
+    decimals: int = 3,
+):
+    r"""Lay a tidy table out like Fayat et al.'s Tables A1–A8.
+
+    Rows are the comparisons, columns the time points (both in order of appearance);
+    values below :math:`10^{-3}` print as ``"<0.001"``, others with 3 decimals.
+
+    Parameters
+    ----------
+    tidy : pandas.DataFrame
+        From :func:`between_groups` or :func:`against_baseline`.
+    value : str
+        Column to show (``"p_paper"``, ``"p"``, ``"p_holm"``, ``"p_bh"``, ``"hl"``…).
+    output : {"text", "styler", "frame"}
+        ``"text"``: strings with ``*``, ``**``, ``***`` for values below 0.05, 0.01,
+        0.001 (for p-value columns); ``"styler"``: a pandas ``Styler`` with
+        yellow / green / blue backgrounds at the same thresholds;
+        ``"frame"``: the numeric pivot.
+    decimals : int
+        Decimals shown.
+
+    Returns
+    -------
+    pandas.DataFrame or pandas.io.formats.style.Styler
+    """
+    for c in ("comparison", "timepoint", value):
+        if c not in tidy.columns:
+            raise ValueError(f"tidy has no column {value if c == value else c!r}")
+    if output not in ("text", "styler", "frame"):
+        raise ValueError(f"output must be 'text', 'styler' or 'frame', got {output!r}")
+    decimals = _validate.integer(decimals, "decimals", minimum=0)
+    rows = list(dict.fromkeys(tidy["comparison"]))
+    cols = list(dict.fromkeys(tidy["timepoint"]))
+    grid = tidy.pivot_table(
+        index="comparison",
+        columns="timepoint",
+        values=value,
+        aggfunc="first",
+        dropna=False,
+    ).reindex(index=rows, columns=cols)
+    grid.index.name, grid.columns.name = None, None
+    if output == "frame":
+        return grid
+    is_p = value == "p" or value.startswith("p_")
+    text = grid.map(lambda v: _fmt(v, decimals))
+    if output == "text":
+        return text + grid.map(_stars) if is_p else text
+
+    def colour(_):
+        out = pd.DataFrame("", index=grid.index, columns=grid.columns)
+        if is_p:
+            for t, c in zip(THRESHOLDS, COLOURS):
+                out = out.mask(grid < t, f"background-color: {c}")
+        return out
+
+    return text.style.apply(colour, axis=None)
