@@ -683,3 +683,19 @@ def test_no_warnings_in_ordinary_use():
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         S.between_groups(_cohort(), "immobility", COMPARISONS)
+
+
+def test_published_fayat_tables_sit_on_the_exact_lattices():
+    """Fayat et al. (2021) Table A2's ShamArsanilate row (n = 5 pairs, family of 6):
+    printed values are multiples of 6/32, the exact one-sided signed-rank lattice."""
+    a2 = S.fayat_table("A2")
+    row = a2.loc["ShamArsanilate vs. ShamArsanilate baseline"]
+    for printed in row:
+        k = float(printed) / (6 / 32)
+        if abs(k - round(k)) > 0.02:  # 3.469 needs n = 6 pairs (see the chapter)
+            assert (
+                abs(float(printed) / (6 / 64) - round(float(printed) / (6 / 64))) < 0.02
+            )
+    assert list(a2.columns) == list(S.FAYAT_TIME_POINTS)
+    with pytest.raises(ValueError, match="name"):
+        S.fayat_table("A9")

@@ -53,6 +53,7 @@ from .nonparametric import (
     signed_rank_p_lattice,
     wilcoxon_signed_rank,
 )
+from .published import FAYAT_TABLES, FAYAT_TIME_POINTS, fayat_table
 from .power import (
     PowerResult,
     animals_needed,
@@ -71,6 +72,9 @@ from .tables import (
 )
 
 __all__ = [
+    "FAYAT_TABLES",
+    "FAYAT_TIME_POINTS",
+    "fayat_table",
     "ALTERNATIVES",
     "ZERO_METHODS",
     "TestResult",
