@@ -498,3 +498,24 @@ def test_broad_trials_as_a_cohort_grouped_by_trial_type(data_mirror, tmp_path):
         < 2.0
     )
     assert math.isfinite(float(ds["tilt_immobile_sagittal_deg"].mean()))
+
+
+def test_session_tilt_is_the_pipelines_tilt():
+    """session_tilt returns the corrected Recording and the tilt that session_features
+    summarises: the immobile mean tilt recomputed from it equals the feature."""
+    from tiltlab import behavior, simulate
+
+    rec = simulate.simulate_session(60.0, 100.0, seed=3)
+    config = cohort.FeatureConfig()
+    feats = cohort.session_features(rec, config)
+    corrected, g = cohort.session_tilt(rec, config)
+    assert g.dims == ("time", "axis") and g.attrs["fs"] == 100.0
+    assert corrected["gyr"].attrs["units"] == rec["gyr"].attrs["units"]
+    imm = behavior.detect_immobility(
+        behavior.angular_speed(corrected), threshold_deg_s=config.threshold_deg_s
+    )
+    mu = g[imm].sum("time")
+    mu = mu / np.linalg.norm(mu)
+    np.testing.assert_allclose(
+        mu, [float(feats[f"tilt_immobile_{a}"]) for a in "xyz"], atol=1e-9
+    )

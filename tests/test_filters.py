@@ -398,6 +398,7 @@ ALL_METHODS = {
     "madgwick",
     "mahony",
     "ekf",
+    "eskf",
     "smoother",
     "rts_smoother",
     "vqf",

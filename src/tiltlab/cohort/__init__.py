@@ -31,7 +31,7 @@ References
 """
 
 from .config import FeatureConfig
-from .features import empty_features, feature_specs, session_features
+from .features import empty_features, feature_specs, session_features, session_tilt
 from .manifest import (
     OPTIONAL_COLUMNS,
     READERS,
@@ -59,6 +59,7 @@ __all__ = [
     "feature_specs",
     "empty_features",
     "session_features",
+    "session_tilt",
     "REQUIRED_COLUMNS",
     "OPTIONAL_COLUMNS",
     "READERS",

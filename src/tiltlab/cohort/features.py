@@ -193,6 +193,48 @@ def _corrected(rec: xr.Dataset, config: FeatureConfig, calibration):
     return rec, off
 
 
+def session_tilt(
+    recording: xr.Dataset,
+    config: FeatureConfig | None = None,
+    *,
+    calibration=None,
+) -> tuple[xr.Dataset, xr.DataArray]:
+    """The corrected Recording and the tilt of one session, as the feature pipeline sees them.
+
+    The first steps of :func:`session_features`, for figures that need the per-sample data
+    (tilt maps, angular velocity in a gravity-aligned frame): the tumble-test calibration
+    (when given), the session's gyroscope offset (``config.gyr_offset``), then the
+    orientation method of ``config`` and the gravity-up direction.
+
+    Parameters
+    ----------
+    recording : xarray.Dataset
+        A Recording; not modified.
+    config : FeatureConfig, optional
+        Default :class:`FeatureConfig()`.
+    calibration : xarray.Dataset or tiltlab.calibration.Calibration, optional
+        The subject's tumble test (see :func:`session_features`).
+
+    Returns
+    -------
+    rec : xarray.Dataset
+        The corrected Recording.
+    tilt : xarray.DataArray
+        Gravity-up direction in the sensor frame (time, axis), with ``fs`` and the method.
+    """
+    config = config or FeatureConfig()
+    rec, _ = _corrected(recording, config, calibration)
+    return rec, _tilt(rec, config)
+
+
+def _tilt(rec: xr.Dataset, config: FeatureConfig) -> xr.DataArray:
+    """Gravity-up direction of a corrected Recording with the configured method."""
+    q = _filters.estimate(
+        rec, config.method, use_mag=config.use_mag, **config.method_params
+    )
+    return _filters.gravity(q)
+
+
 def _immobile(speed, config: FeatureConfig, threshold: float) -> np.ndarray:
     return np.asarray(
         _behavior.detect_immobility(
@@ -278,11 +320,7 @@ def session_features(
     out: dict[str, float] = {"n_samples": n, "duration_s": n / fs}
     out.update({f"gyr_offset_{a}": float(o) for a, o in zip("xyz", off)})
 
-    g = _filters.gravity(
-        _filters.estimate(
-            rec, config.method, use_mag=config.use_mag, **config.method_params
-        )
-    )
+    g = _tilt(rec, config)
     gv = g.values
     speed = _behavior.angular_speed(rec)
     sp = np.asarray(speed, float)

@@ -23,6 +23,10 @@ Methods
 ``ekf``
     Quaternion-state extended Kalman filter with the gravity (and magnetic field)
     direction as measurement (the formulation of the ``ahrs`` package).
+``eskf``
+    Error-state Kalman filter (Solà 2017; the ESKF baseline of Zaheer et al. 2023):
+    attitude and gyro bias, accelerometer direction with an adaptive variance, and a
+    heading-only magnetometer update.
 ``smoother``
     Offline (non-causal) tilt: rest-detected gyro bias, strapdown integration, and a
     zero-phase low-pass of the specific force expressed in the integrated frame; for
@@ -44,6 +48,7 @@ Package layout
 One module per method family — :mod:`~tiltlab.filters.lowpass`,
 :mod:`~tiltlab.filters.complementary`, :mod:`~tiltlab.filters.madgwick`,
 :mod:`~tiltlab.filters.mahony`, :mod:`~tiltlab.filters.ekf`,
+:mod:`~tiltlab.filters.eskf`,
 :mod:`~tiltlab.filters.smoothers` (``smoother``, ``rest_gyro_bias``),
 :mod:`~tiltlab.filters.rts` and :mod:`~tiltlab.filters.adapters` — plus
 :mod:`~tiltlab.filters.registry` (:data:`METHODS`: each method's function, whether it
@@ -134,6 +139,7 @@ from .adapters import (
 )
 from .complementary import complementary
 from .ekf import ekf
+from .eskf import eskf
 from .lowpass import lowpass_tilt
 from .madgwick import madgwick, madgwick_batch
 from .mahony import mahony
@@ -161,6 +167,7 @@ __all__ = [
     "madgwick_batch",
     "mahony",
     "ekf",
+    "eskf",
     "smoother",
     "rest_gyro_bias",
     "rts_smoother",

@@ -26,6 +26,7 @@ from typing import Any
 from . import adapters
 from .complementary import complementary
 from .ekf import ekf
+from .eskf import eskf
 from .lowpass import lowpass_tilt
 from .madgwick import madgwick
 from .mahony import mahony
@@ -165,6 +166,13 @@ METHODS: Mapping[str, Method] = _registry(
         "Mahony's explicit complementary filter with gyro-bias integral",
     ),
     Method("ekf", ekf, "causal", "quaternion-state EKF (ahrs formulation)"),
+    Method(
+        "eskf",
+        eskf,
+        "causal",
+        "error-state Kalman filter (attitude, gyro bias; adaptive accelerometer "
+        "variance, heading-only magnetometer update)",
+    ),
     Method(
         "smoother",
         smoother,
