@@ -294,3 +294,21 @@ def test_residence_figure(no_cartopy_data, tilt, mesh):
 def test_old_spheremaps_module_is_gone():
     with pytest.raises(ImportError):
         import tiltlab.spheremaps  # noqa: F401
+
+
+def test_group_lines_median_and_iqr():
+    import pandas as pd
+
+    df = pd.DataFrame(
+        {
+            "group": ["a"] * 6 + ["b"] * 6,
+            "t": ["0", "0", "0", "1", "1", "1"] * 2,
+            "v": [1.0, 2.0, 9.0, 2.0, 3.0, 4.0, 0.0, 0.0, 1.0, 5.0, 6.0, 7.0],
+        }
+    )
+    ax = plot.group_lines(df, "v", x="t", hue="group", err="iqr")
+    line = ax.get_lines()[0]
+    np.testing.assert_allclose(line.get_ydata(), [2.0, 3.0])  # medians, not means
+    assert len(legend_texts(ax)) == 2
+    with pytest.raises(ValueError, match="err"):
+        plot.group_lines(df, "v", x="t", hue="group", err="ci")

@@ -94,7 +94,9 @@ def tukey_boxplot(
     units = units if units is not None else u
     cats = _order(df, by, order)
     hues = _order(df, hue, hue_order) if hue is not None else [None]
-    ax = new_axes(ax, figsize=(max(4.0, 1.2 * len(cats) * max(1, len(hues))), 3.5))
+    # at most the book's column width (9 in); many boxes get narrower
+    width = min(9.0, max(4.0, 0.35 * len(cats) * max(1, len(hues))))
+    ax = new_axes(ax, figsize=(width, 3.5))
     width = 0.8 / len(hues)
     rng = np.random.default_rng(seed)
     for k, h in enumerate(hues):
@@ -153,7 +155,7 @@ def group_lines(
     hue_order: Sequence | None = None,
     title: str | None = None,
 ):
-    """Mean of a feature per category of ``x`` (e.g. time points), one line per ``hue`` (group).
+    """Centre of a feature per category of ``x`` (e.g. time points), one line per ``hue``.
 
     Parameters
     ----------
@@ -169,8 +171,10 @@ def group_lines(
     units : str, optional
     name : str, optional
         y label (default ``value``).
-    err : {"sem", "sd", None}
-        Error bars: standard error of the mean, standard deviation, or none.
+    err : {"sem", "sd", "iqr", None}
+        Error bars: standard error of the mean or standard deviation around the mean;
+        ``"iqr"``: the median with its interquartile range (robust, as in Fayat et al.'s
+        trajectories); None: the mean without bars.
     order, hue_order : sequence, optional
     title : str, optional
 
@@ -178,8 +182,8 @@ def group_lines(
     -------
     matplotlib.axes.Axes
     """
-    if err not in ("sem", "sd", None):
-        raise ValueError(f"err must be 'sem', 'sd' or None, got {err!r}")
+    if err not in ("sem", "sd", "iqr", None):
+        raise ValueError(f"err must be 'sem', 'sd', 'iqr' or None, got {err!r}")
     df, u = _table(data, value)
     units = units if units is not None else u
     xs = _order(df, x, order)
@@ -189,6 +193,18 @@ def group_lines(
         mean = g.mean().reindex(xs)
         if err is None:
             ax.plot(range(len(xs)), mean.to_numpy(float), marker="o", label=str(h))
+        elif err == "iqr":
+            med = g.median().reindex(xs).to_numpy(float)
+            q1 = g.quantile(0.25).reindex(xs).to_numpy(float)
+            q3 = g.quantile(0.75).reindex(xs).to_numpy(float)
+            ax.errorbar(
+                range(len(xs)),
+                med,
+                yerr=np.vstack([med - q1, q3 - med]),
+                marker="o",
+                capsize=2,
+                label=str(h),
+            )
         else:
             spread = g.std(ddof=1).reindex(xs)
             if err == "sem":
