@@ -99,6 +99,20 @@ def zoh_step_scalar(w, x, y, z, rx, ry, rz):
 
 
 @njit(cache=True, inline="always")
+def rotmat_scalar(w, x, y, z, R):
+    """Write the rotation matrix R(q) of a unit quaternion into the (3, 3) array ``R``."""
+    R[0, 0] = 1.0 - 2.0 * (y * y + z * z)
+    R[0, 1] = 2.0 * (x * y - w * z)
+    R[0, 2] = 2.0 * (x * z + w * y)
+    R[1, 0] = 2.0 * (x * y + w * z)
+    R[1, 1] = 1.0 - 2.0 * (x * x + z * z)
+    R[1, 2] = 2.0 * (y * z - w * x)
+    R[2, 0] = 2.0 * (x * z - w * y)
+    R[2, 1] = 2.0 * (y * z + w * x)
+    R[2, 2] = 1.0 - 2.0 * (x * x + y * y)
+
+
+@njit(cache=True, inline="always")
 def rotate_scalar(w, x, y, z, vx, vy, vz):
     """R(q) v for one quaternion and one vector, via v + 2w(u×v) + 2u×(u×v)."""
     tx = 2.0 * (y * vz - z * vy)

@@ -14,6 +14,7 @@ from .. import _validate as _v
 from ..quaternion import (
     qmul_scalar,
     rotate_scalar,
+    rotmat_scalar,
     rotvec_to_quat_scalar,
     zoh_step_scalar,
 )
@@ -116,16 +117,7 @@ def _eskf_kernel(
         )
         nq = np.sqrt(w * w + x * x + y * y + z * z)
         w, x, y, z = w / nq, x / nq, y / nq, z / nq
-        # R = R(q_k), row-major
-        Rm[0, 0] = 1.0 - 2.0 * (y * y + z * z)
-        Rm[0, 1] = 2.0 * (x * y - w * z)
-        Rm[0, 2] = 2.0 * (x * z + w * y)
-        Rm[1, 0] = 2.0 * (x * y + w * z)
-        Rm[1, 1] = 1.0 - 2.0 * (x * x + z * z)
-        Rm[1, 2] = 2.0 * (y * z - w * x)
-        Rm[2, 0] = 2.0 * (x * z - w * y)
-        Rm[2, 1] = 2.0 * (y * z + w * x)
-        Rm[2, 2] = 1.0 - 2.0 * (x * x + y * y)
+        rotmat_scalar(w, x, y, z, Rm)  # R = R(q_k)
         # P ← F P Fᵀ + Q, F = [[I, −Δt R], [0, I]]:
         # Pθθ' = Pθθ − Δt (R Pbθ + Pθb Rᵀ) + Δt² R Pbb Rᵀ, Pθb' = Pθb − Δt R Pbb
         for i in range(3):  # T[:3, :] = rows of F P for δθ: Pθ· − Δt R Pb·

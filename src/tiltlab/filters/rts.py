@@ -10,7 +10,12 @@ import numpy as np
 from numba import njit
 
 from .. import _validate as _v
-from ..quaternion import qmul_scalar, rotvec_to_quat_scalar, zoh_step_scalar
+from ..quaternion import (
+    qmul_scalar,
+    rotmat_scalar,
+    rotvec_to_quat_scalar,
+    zoh_step_scalar,
+)
 from ._common import samples, start_orientation
 from .smoothers import rest_gyro_bias
 
@@ -20,25 +25,12 @@ _RTS_N = 15  # error state: attitude (world frame) φ, gyro bias b, velocity v, 
 _RTS_X = 12  # nominal state besides q: b, v, p, s
 
 
-@njit(cache=True, nogil=True, inline="always")
-def _rts_rotmat(w, x, y, z, R):
-    R[0, 0] = 1.0 - 2.0 * (y * y + z * z)
-    R[0, 1] = 2.0 * (x * y - w * z)
-    R[0, 2] = 2.0 * (x * z + w * y)
-    R[1, 0] = 2.0 * (x * y + w * z)
-    R[1, 1] = 1.0 - 2.0 * (x * x + z * z)
-    R[1, 2] = 2.0 * (y * z - w * x)
-    R[2, 0] = 2.0 * (x * z - w * y)
-    R[2, 1] = 2.0 * (y * z + w * x)
-    R[2, 2] = 1.0 - 2.0 * (x * x + y * y)
-
-
 @njit(cache=True, nogil=True)
 def _rts_transition(w, x, y, z, a, wc0, wc1, wc2, dt, R, F):
     # F = ∂δx_k/∂δx_{k-1} of the world-frame error state (φ, b, v, p, s), evaluated at the
     # predicted attitude q_{k|k-1} (R = R(q)), the corrected rate ω_c and the specific force
     # a_k; returns R a_k
-    _rts_rotmat(w, x, y, z, R)
+    rotmat_scalar(w, x, y, z, R)
     sx = R[0, 0] * a[0] + R[0, 1] * a[1] + R[0, 2] * a[2]
     sy = R[1, 0] * a[0] + R[1, 1] * a[1] + R[1, 2] * a[2]
     sz = R[2, 0] * a[0] + R[2, 1] * a[1] + R[2, 2] * a[2]
