@@ -112,6 +112,38 @@ def test_features_recover_the_planted_truth(sim, serial):
     assert list(ds["hours"].values[:3]) == [-1.0, 24.0, 168.0]
 
 
+def test_cli_run_writes_a_features_file_that_recovers_the_truth(sim, serial, tmp_path):
+    """``tiltlab cohort run`` on the simulated cohort (recomputed: fresh cache) writes a
+    feature file with the same features as the API run, within the recovery bounds."""
+    from tiltlab import cli
+
+    out = tmp_path / "features.nc"
+    code = cli.main(
+        [
+            "cohort",
+            "run",
+            str(sim / "manifest.csv"),
+            "--out",
+            str(out),
+            "--cache-dir",
+            str(tmp_path / "cache"),
+            "--no-progress",
+        ]
+    )
+    assert code == 0
+    ds = cohort.load_features(out)
+    assert ds.attrs["n_computed"] == 36
+    truth = pd.read_csv(sim / "truth.csv").set_index("session").loc[ds["session"]]
+    d_imm = np.abs(ds["immobile_fraction"].values - truth["immobile_fraction_true"])
+    assert d_imm.max() <= 0.02, d_imm.max()
+    mu = np.stack([ds[f"tilt_immobile_{a}"].values for a in "xyz"], axis=1)
+    mu_true = truth[[f"tilt_immobile_{a}_true" for a in "xyz"]].to_numpy()
+    assert np.degrees(sphere.angle(mu, mu_true)).max() <= 3.0
+    xr.testing.assert_allclose(
+        _values(ds)[_features(ds)], _values(serial[0])[_features(ds)]
+    )
+
+
 def test_dask_local_cluster_gives_identical_features(sim, serial, tmp_path):
     ds, _ = serial
     dd = cohort.run_cohort(
