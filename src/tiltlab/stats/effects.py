@@ -39,6 +39,13 @@ in place of :math:`\alpha/2` and one end only. These are R's
 approximation when there are ties or zeros, whereas here the order-statistic interval
 is kept (the test-inversion of the exact test for continuous data).
 
+Checked against published worked examples: Hollander, Wolfe & Chicken's Hamilton
+depression-scale data (n = 9) give the printed pseudo-median −0.46 and 96.1 % interval
+(−0.786, −0.010). On SAS's NPAR1WAY Hodges–Lehmann example (heavily tied reaction
+times) the shift 0.35 agrees; the interval (0.00, 0.82) equals the shifts accepted by
+the exact conditional (tie-aware) rank-sum test, whereas SAS's "exact" limits
+(0.00, 1.33) take one order statistic further out on each side.
+
 The matched-pairs rank-biserial correlation is :math:`(T^+ - T^-)/(T^+ + T^-)`
 (Kerby 2014; ``pingouin.wilcoxon``'s ``RBC`` for ``alternative != "less"``), and the
 paired probability of superiority is :math:`P(D > 0) + \frac12 P(D = 0)` with a Wilson
