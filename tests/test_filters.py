@@ -407,6 +407,7 @@ ALL_METHODS = {
     "ahrs_madgwick",
     "ahrs_mahony",
     "ahrs_ekf",
+    "riann",
 }
 
 

@@ -37,6 +37,9 @@ Methods
     Rauch–Tung–Striebel backward pass.
 ``vqf``, ``offline_vqf``
     Adapters to the ``vqf`` package (Laidig & Seel 2023), for comparison.
+``riann``
+    Adapter to RIANN (Weber, Gühmann & Seel 2021), a published recurrent network for
+    6D attitude estimation (``riann`` package, ONNX; extra ``learn``).
 ``imufusion``
     Adapter to the ``imufusion`` package (x-io Fusion AHRS, 6D), for comparison.
 ``ahrs_madgwick``, ``ahrs_mahony``, ``ahrs_ekf``
@@ -135,6 +138,7 @@ from .adapters import (
     run_ahrs_mahony,
     run_imufusion,
     run_offline_vqf,
+    run_riann,
     run_vqf,
 )
 from .complementary import complementary
@@ -147,6 +151,7 @@ from .recordings import Inputs, estimate, gravity, prepare, run
 from .registry import METHODS, Method, defaults, get_method, methods
 from .rts import rts_smoother
 from .smoothers import rest_gyro_bias, smoother
+from .vectors import davenport, magnetic_dip
 
 __all__ = [
     "METHODS",
@@ -174,6 +179,9 @@ __all__ = [
     "run_vqf",
     "run_offline_vqf",
     "run_imufusion",
+    "run_riann",
+    "davenport",
+    "magnetic_dip",
     "run_ahrs_madgwick",
     "run_ahrs_mahony",
     "run_ahrs_ekf",

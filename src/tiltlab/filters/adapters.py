@@ -1,10 +1,12 @@
 """Adapters to reference implementations, for comparison: ``vqf`` (VQF and offlineVQF,
-Laidig & Seel 2023), ``imufusion`` (x-io Fusion AHRS) and the pure-Python ``ahrs``
-package (Madgwick, Mahony, EKF).
+Laidig & Seel 2023), ``imufusion`` (x-io Fusion AHRS), the pure-Python ``ahrs``
+package (Madgwick, Mahony, EKF) and ``riann`` (RIANN, the published recurrent network of
+Weber, Gühmann & Seel 2021).
 
 Each adapter takes the filters' inputs — ``acc`` in m/s², ``gyr`` in rad/s, ``fs`` in
 Hz, optional ``mag`` — and returns (N, 4) scalar-first quaternions sensor → world with
-world z up. The packages are optional (extra ``compare``) and imported on first use.
+world z up. The packages are optional (extra ``compare``; ``riann`` and
+``onnxruntime``: extra ``learn``) and imported on first use.
 """
 
 from __future__ import annotations
@@ -23,6 +25,7 @@ __all__ = [
     "run_ahrs_madgwick",
     "run_ahrs_mahony",
     "run_ahrs_ekf",
+    "run_riann",
 ]
 
 
@@ -171,3 +174,74 @@ def run_ahrs_ekf(
     ]
     f = af.EKF(gyr=gyr, acc=acc, frequency=fs, frame="NED", q0=q0, noises=noises)
     return np.asarray(f.Q, float)
+
+
+def run_riann(acc, gyr, fs: float, *, mag=None) -> np.ndarray:
+    """RIANN, a published recurrent network for attitude estimation (``riann``), 6D.
+
+    Parameters
+    ----------
+    acc : array_like, shape (N, 3)
+        Specific force, m/s².
+    gyr : array_like, shape (N, 3)
+        Angular rate, rad/s.
+    fs : float
+        Sampling rate, Hz (mandatory; the network takes the sampling interval as an
+        input, so any rate is accepted).
+    mag : None
+        Present for the adapters' uniform signature only: RIANN is a 6D method, and any
+        ``mag`` other than None is a ValueError.
+
+    Returns
+    -------
+    numpy.ndarray, shape (N, 4), float64
+        Unit quaternions (w, x, y, z) sensor → world, world z up, heading arbitrary.
+
+    Raises
+    ------
+    ImportError
+        The ``riann`` package (or ``onnxruntime``) is not installed.
+    ValueError
+        ``mag`` given, an invalid ``fs``, or non-finite or mismatched ``acc``/``gyr``.
+
+    Notes
+    -----
+    The network is the ONNX model shipped inside the ``riann`` package (no download),
+    run on CPU by ``onnxruntime`` with a zero initial hidden state, so the first
+    samples are a transient. Its output already follows tiltlab's convention
+    (scalar-first, sensor → world, world z up: at rest, :func:`tiltlab.quaternion.gravity`
+    of the output is the direction of ``acc``), so it is only cast to float64 and
+    renormalised (the network computes in float32). The model path is passed
+    explicitly because ``riann`` 0.2.0's own default lookup depends on the working
+    directory. ``RIANN.predict`` runs the whole sequence in one call; it equals the
+    step-by-step ``predict_sequence`` (to float32 rounding) without storing every
+    hidden state.
+
+    References
+    ----------
+    .. [1] D. Weber, C. Gühmann, T. Seel, "RIANN — A Robust Neural Network
+       Outperforms Attitude Estimation Filters", AI 2(3):444–463, 2021.
+       https://doi.org/10.3390/ai2030028
+    """
+    try:
+        import importlib.resources
+
+        from riann.riann import RIANN
+    except ImportError as e:
+        raise ImportError(
+            "run_riann needs the 'riann' package and onnxruntime: install the learn "
+            "extra (pip install tiltlab[learn])"
+        ) from e
+
+    fs = _v.check_fs(fs)
+    if mag is not None:
+        raise ValueError(
+            "RIANN is a 6D method (accelerometer and gyroscope) and takes no "
+            "magnetometer: pass mag=None"
+        )
+    acc, gyr, _, _ = sensor_inputs(acc, gyr)
+    model = importlib.resources.files("riann") / "riann.onnx"
+    with importlib.resources.as_file(model) as path:
+        net = RIANN(str(path))
+    q = np.asarray(net.predict(acc, gyr, fs), dtype=np.float64).reshape(-1, 4)
+    return q / np.linalg.norm(q, axis=1, keepdims=True)

@@ -8,7 +8,9 @@ signature with :mod:`inspect`, so that a default value is written in exactly one
   ``tau_acc_s``, …): the tunable parameters, recorded in :func:`estimate`'s attrs;
 * ``options`` — the array-valued initial-state arguments that :func:`estimate` passes
   through (``q0``, ``b0``, ``P0``, ``bias``);
-* ``supports_mag`` — the function has a ``mag`` argument (9D possible);
+* ``supports_mag`` — the function has a ``mag`` argument (9D possible), unless the
+  entry is marked ``six_d`` (an adapter that keeps ``mag=None`` only for the uniform
+  signature: RIANN);
 * ``uses_gyr`` — the function has a ``gyr`` argument (``lowpass`` has not).
 
 Adapters to the ``vqf`` package also accept that package's own parameters
@@ -62,6 +64,10 @@ class Method:
     extra_params : callable, optional
         Returns the names of further parameters the function accepts through
         ``**kwargs`` (the ``vqf`` adapters).
+    six_d : bool
+        The method is 6D only although its function has a ``mag`` argument (kept, as
+        ``mag=None``, for the adapters' uniform signature): ``supports_mag`` is False,
+        so ``use_mag=True`` is refused before any data are read.
     """
 
     name: str
@@ -69,6 +75,7 @@ class Method:
     kind: str
     description: str
     extra_params: Callable[[], Collection[str]] | None = None
+    six_d: bool = False
 
     def _signature(self) -> Mapping[str, inspect.Parameter]:
         return inspect.signature(self.function).parameters
@@ -97,7 +104,7 @@ class Method:
     @property
     def supports_mag(self) -> bool:
         """Whether the method can use a magnetometer (9D)."""
-        return "mag" in self._signature()
+        return not self.six_d and "mag" in self._signature()
 
     @property
     def uses_gyr(self) -> bool:
@@ -206,6 +213,13 @@ METHODS: Mapping[str, Method] = _registry(
         adapters.run_imufusion,
         "adapter",
         "x-io Fusion AHRS (imufusion package)",
+    ),
+    Method(
+        "riann",
+        adapters.run_riann,
+        "adapter",
+        "RIANN, a published recurrent network (riann package, 6D)",
+        six_d=True,
     ),
     Method(
         "ahrs_madgwick",
