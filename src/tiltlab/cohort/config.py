@@ -48,7 +48,7 @@ class FeatureConfig:
     method : str
         Orientation method of :func:`tiltlab.filters.estimate` (any name of
         :func:`tiltlab.filters.methods`). Default ``"smoother"``: the offline tilt
-        smoother, following chapter 5's benchmark (offline methods are the most
+        smoother, following the filter benchmark chapter (offline methods are the most
         accurate on BROAD and the right tool for post-hoc analysis; the low-pass of the
         accelerometer, Fayat's choice with ``cutoff_hz=2.0``, is the least accurate on
         simulated freely moving rats). Use ``method="lowpass",

@@ -15,12 +15,14 @@ Submodules
   grids of maps, residence maps ;
 * :mod:`~tiltlab.plot.scores` — estimator errors: parameter-grid heat maps and curves,
   per-trial bars, ECDFs, errors binned by speed;
-* :mod:`~tiltlab.plot.cohort` — Tukey boxplots and group means for cohort tables.
+* :mod:`~tiltlab.plot.cohort` — Tukey boxplots and group means for cohort tables;
+* :mod:`~tiltlab.plot.learning` — training curves and per-trial errors by method.
 
 Everything is re-exported here: ``from tiltlab import plot; plot.kde_map(k)``.
 """
 
 from .cohort import group_lines, tukey_boxplot
+from .learning import learning_curves, method_strips
 from .mapfigures import (
     facet_map,
     kde_map,
@@ -99,4 +101,7 @@ __all__ = [
     # cohort
     "tukey_boxplot",
     "group_lines",
+    # learning
+    "learning_curves",
+    "method_strips",
 ]

@@ -1,0 +1,103 @@
+"""``python -m tiltlab.learn``: train the learned estimators with grouped
+cross-validation on BROAD, check committed model files.
+
+Examples
+--------
+::
+
+    python -m tiltlab.learn train --out data/learn            # the committed models
+    python -m tiltlab.learn train --out /tmp/quick --epochs 1 --trials 1 2 24 25
+    python -m tiltlab.learn ablate --out data/learn           # Tables 2-3 in small
+    python -m tiltlab.learn check data/learn                  # verify SHA256SUMS
+"""
+
+from __future__ import annotations
+
+import argparse
+import shlex
+import sys
+from collections.abc import Sequence
+
+from .cv import ablate, check_files, cross_validate
+from .training import TrainConfig
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    p = argparse.ArgumentParser(prog="python -m tiltlab.learn", description=__doc__)
+    sub = p.add_subparsers(dest="cmd", required=True)
+    t = sub.add_parser("train", help="grouped cross-validation on BROAD")
+    t.add_argument("--out", required=True, help="output folder")
+    t.add_argument("--folds", type=int, default=5)
+    t.add_argument("--trials", type=int, nargs="*", help="BROAD trials (default: all)")
+    t.add_argument(
+        "--variants", nargs="*", default=["quaternion", "gain"], help="model variants"
+    )
+    defaults = TrainConfig()
+    for name in ("epochs", "batch", "stride", "channels", "seed", "threads"):
+        t.add_argument(f"--{name}", type=int, default=getattr(defaults, name))
+    t.add_argument("--lr", type=float, default=defaults.lr)
+    t.add_argument("--loss", default=defaults.loss)
+    t.add_argument("--total", default=defaults.total)
+    t.add_argument(
+        "--activations", nargs=3, default=list(defaults.activations), metavar="ACT"
+    )
+    a = sub.add_parser("ablate", help="activation and loss ablations on one fold")
+    a.add_argument("--out", required=True, help="output folder")
+    a.add_argument("--fold", type=int, default=0)
+    a.add_argument("--folds", type=int, default=5)
+    a.add_argument("--epochs", type=int, default=2)
+    a.add_argument("--threads", type=int, default=defaults.threads)
+    c = sub.add_parser("check", help="verify the files listed in SHA256SUMS")
+    c.add_argument("folder")
+    args = p.parse_args(argv)
+    try:
+        if args.cmd == "check":
+            for name, digest in check_files(args.folder).items():
+                print(f"ok  {digest[:16]}  {name}")
+            return 0
+        argv_list = list(sys.argv[1:] if argv is None else argv)
+        command = "python -m tiltlab.learn " + shlex.join(argv_list)
+        progress = lambda s: print(s, file=sys.stderr, flush=True)  # noqa: E731
+        if args.cmd == "ablate":
+            table = ablate(
+                args.out,
+                fold=args.fold,
+                n_folds=args.folds,
+                epochs=args.epochs,
+                config=TrainConfig(threads=args.threads),
+                command=command,
+                progress=progress,
+            )
+            print(table.round(3).to_string(index=False))
+            return 0
+        cfg = TrainConfig(
+            epochs=args.epochs,
+            batch=args.batch,
+            stride=args.stride,
+            channels=args.channels,
+            seed=args.seed,
+            threads=args.threads,
+            lr=args.lr,
+            loss=args.loss,
+            total=args.total,
+            activations=tuple(args.activations),
+        )
+        table = cross_validate(
+            args.out,
+            trials=args.trials,
+            n_folds=args.folds,
+            variants=args.variants,
+            config=cfg,
+            command=command,
+            progress=progress,
+        )
+    except (ValueError, OSError) as err:
+        print(f"tiltlab.learn: {err}", file=sys.stderr)
+        return 1
+    summary = table.groupby("variant")[["qae_mean", "inclination", "total"]].mean()
+    print(summary.round(2).to_string())
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

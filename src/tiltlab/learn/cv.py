@@ -1,0 +1,400 @@
+r"""Grouped cross-validation on BROAD, the committed model files, and the comparison
+table against filters and RIANN.
+
+Folds are groups of whole trials: no window of a test trial is ever seen in training.
+Trials are dealt to the folds in order within each BROAD group (undisturbed and
+disturbed separately), so every fold holds disturbed trials in its test set.
+
+Files written by :func:`cross_validate` (the ``learn`` command) in its output folder:
+
+* ``<variant>_fold<k>.pt``: weights, configuration and ``fs`` (:func:`save`);
+* ``run.json``: the command line, the configurations, the folds, package versions;
+* ``history.json``: training curves (per variant, fold and epoch);
+* ``metrics.json``: per test trial, QAE (Eq. 4, degrees) and BROAD's RMSEs;
+* ``SHA256SUMS``: the sha256 of every file above, checked by :func:`check_files`.
+"""
+
+from __future__ import annotations
+
+import json
+import platform
+import time
+from collections.abc import Callable, Iterable, Sequence as Seq
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from .. import _validate as _v
+from .. import datasets
+from .. import evaluate
+from .. import filters
+from .. import quaternion as quat
+from .data import sequence
+from .training import TrainConfig, load, run, save, sha256, train, write_json
+
+__all__ = [
+    "ABLATIONS",
+    "ablate",
+    "folds",
+    "cross_validate",
+    "check_files",
+    "trial_errors",
+    "learned_estimate",
+    "compare",
+    "BASELINES",
+]
+
+#: Baselines of the comparison: label -> (registry method, 9D)
+BASELINES: dict[str, tuple[str, bool]] = {
+    "Mahony 9D": ("mahony", True),
+    "ESKF 9D": ("eskf", True),
+    "VQF 9D": ("vqf", True),
+    "RIANN 6D": ("riann", False),
+}
+
+
+def folds(trials: Iterable[int], n_folds: int) -> list[list[int]]:
+    """Deal BROAD trials to ``n_folds`` test folds, undisturbed and disturbed separately
+    (in trial order), so that each fold has both kinds."""
+    groups = datasets.broad_trial_groups()
+    trials = sorted(int(t) for t in trials)
+    if n_folds < 2 or n_folds > len(trials):
+        raise ValueError(f"n_folds must be in 2..{len(trials)}, got {n_folds}")
+    out: list[list[int]] = [[] for _ in range(n_folds)]
+    k = 0
+    for kind in ("undisturbed", "disturbed"):
+        for t in trials:
+            if kind in groups.get(t, []):
+                out[k % n_folds].append(t)
+                k += 1
+    return [sorted(f) for f in out]
+
+
+def trial_errors(q, recording) -> dict[str, float]:
+    """QAE (Eq. 4; mean and median, degrees) and BROAD's RMSEs of an estimate, over the
+    movement samples with a valid reference."""
+    e = evaluate.broad_errors(q, recording)
+    q = np.asarray(q, float)
+    ref = recording["q_ref"].transpose("time", "quat").values
+    mask = np.all(np.isfinite(ref), axis=1) & recording["movement"].values.astype(bool)
+    d = np.abs(np.sum(q[mask] * ref[mask], axis=1))
+    qae_deg = np.degrees(np.arccos(np.clip(2 * d * d - 1, -1, 1)))
+    return {
+        "qae_mean": float(qae_deg.mean()),
+        "qae_median": float(np.median(qae_deg)),
+        "inclination": e["inclination"],
+        "heading": e["heading"],
+        "total": e["total"],
+    }
+
+
+def cross_validate(
+    out: str | Path,
+    *,
+    trials: Seq[int] | None = None,
+    n_folds: int = 5,
+    variants: Seq[str] = ("quaternion", "gain"),
+    config: TrainConfig | None = None,
+    command: str = "",
+    progress: Callable[[str], None] = print,
+) -> pd.DataFrame:
+    """Train one model per variant and fold, evaluate it on its held-out trials and
+    write the files listed in the module docstring to ``out``.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per (variant, trial) with the fold and :func:`trial_errors`.
+    """
+    import torch
+
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    base = config or TrainConfig()
+    trials = sorted(datasets.broad_trials()) if trials is None else sorted(trials)
+    fold_list = folds(trials, n_folds)
+    recs = {t: datasets.load_broad_trial(t) for t in trials}
+    seqs = {
+        t: sequence(r, acc_scale=base.acc_scale, mag_scale=base.mag_scale)
+        for t, r in recs.items()
+    }
+    history: dict[str, Any] = {}
+    rows: list[dict[str, Any]] = []
+    configs = {}
+    for variant in variants:
+        cfg = TrainConfig.from_dict({**base.to_dict(), "variant": variant})
+        configs[variant] = cfg.to_dict()
+        for k, test in enumerate(fold_list):
+            train_set = [seqs[t] for t in trials if t not in test]
+            progress(f"{variant}, fold {k + 1}/{len(fold_list)}: test trials {test}")
+            t0 = time.perf_counter()
+            model, hist = train(train_set, cfg, progress=progress)
+            history[f"{variant}/fold{k}"] = hist
+            save(model, cfg, train_set[0].fs, out / f"{variant}_fold{k}.pt")
+            for t in test:
+                q = run(model, seqs[t], cfg)
+                rows.append(
+                    {"variant": variant, "fold": k, "trial": t}
+                    | trial_errors(q, recs[t])
+                )
+            progress(f"  done in {time.perf_counter() - t0:.0f} s")
+    table = pd.DataFrame(rows)
+    write_json(
+        {
+            "command": command,
+            "configs": configs,
+            "folds": fold_list,
+            "trials": list(trials),
+            "versions": {
+                "python": platform.python_version(),
+                "torch": torch.__version__,
+                "numpy": np.__version__,
+            },
+        },
+        out / "run.json",
+    )
+    write_json(history, out / "history.json")
+    write_json(table.to_dict(orient="records"), out / "metrics.json")
+    _write_sums(out)
+    return table
+
+
+#: Ablations in the spirit of Zaheer et al.'s Tables 2 (activations: first, hidden,
+#: last) and 3 (total and sample loss), all other settings at their defaults.
+ABLATIONS: dict[str, dict[str, Any]] = {
+    **{
+        f"table2/{'-'.join(a)}": {"activations": a}
+        for a in [
+            ("tanh", "tanh", "tanh"),
+            ("prelu", "prelu", "prelu"),
+            ("prelu", "prelu", "tanh"),
+            ("gelu", "gelu", "gelu"),
+            ("gelu", "gelu", "tanh"),
+        ]
+    },
+    **{
+        f"table3/{total}-{loss}": {"total": total, "loss": loss}
+        for total, loss in [
+            ("L1", "acos_taylor1"),
+            ("L2", "acos_taylor1"),
+            ("L2", "acos_taylor2"),
+            ("L1", "l1_product"),
+            ("L2", "l1_product"),
+            ("L2", "l2_product"),
+        ]
+    },
+}
+
+
+def ablate(
+    out: str | Path,
+    *,
+    fold: int = 0,
+    n_folds: int = 5,
+    epochs: int = 2,
+    config: TrainConfig | None = None,
+    command: str = "",
+    progress: Callable[[str], None] = print,
+) -> pd.DataFrame:
+    """Train the quaternion variant once per entry of :data:`ABLATIONS` on one fold's
+    training trials (``epochs`` epochs) and evaluate it, in closed loop, on that fold's
+    test trials. Writes ``ablation.json`` to ``out``.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per ablation: ``train_qae_deg`` (last epoch, teacher-forced windows),
+        ``test_qae_deg`` and ``test_qae_rad`` (closed loop, mean over the test trials'
+        movement samples), ``test_inclination`` (mean RMSE, degrees).
+    """
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    base = TrainConfig.from_dict(
+        {
+            **(config or TrainConfig()).to_dict(),
+            "epochs": epochs,
+            "variant": "quaternion",
+        }
+    )
+    trials = sorted(datasets.broad_trials())
+    test = folds(trials, n_folds)[fold]
+    recs = {t: datasets.load_broad_trial(t) for t in trials}
+    seqs = {t: sequence(r) for t, r in recs.items()}
+    rows = []
+    for name, change in ABLATIONS.items():
+        cfg = TrainConfig.from_dict({**base.to_dict(), **change})
+        progress(f"{name}")
+        model, hist = train([seqs[t] for t in trials if t not in test], cfg)
+        errs = [trial_errors(run(model, seqs[t], cfg), recs[t]) for t in test]
+        qae_deg = float(np.mean([e["qae_mean"] for e in errs]))
+        rows.append(
+            {
+                "ablation": name,
+                "train_qae_deg": hist[-1]["qae_deg"],
+                "test_qae_deg": qae_deg,
+                "test_qae_rad": float(np.radians(qae_deg)),
+                "test_inclination": float(np.mean([e["inclination"] for e in errs])),
+            }
+        )
+    table = pd.DataFrame(rows)
+    write_json(
+        {
+            "command": command,
+            "base_config": base.to_dict(),
+            "fold": fold,
+            "test_trials": test,
+            "rows": table.to_dict(orient="records"),
+        },
+        out / "ablation.json",
+    )
+    _write_sums(out)
+    return table
+
+
+def _write_sums(out: Path) -> None:
+    names = sorted(
+        p.name for p in out.iterdir() if p.suffix in (".pt", ".json") and p.is_file()
+    )
+    lines = [f"{sha256(out / n)}  {n}" for n in names]
+    (out / "SHA256SUMS").write_text("\n".join(lines) + "\n")
+
+
+def check_files(folder: str | Path) -> dict[str, str]:
+    """Verify every file listed in ``folder/SHA256SUMS``; return name -> sha256.
+
+    Raises
+    ------
+    ValueError
+        Naming the first file that is missing or whose checksum differs.
+    """
+    folder = Path(folder)
+    sums = folder / "SHA256SUMS"
+    if not sums.is_file():
+        raise ValueError(f"no SHA256SUMS in {folder}")
+    out = {}
+    for line in sums.read_text().splitlines():
+        digest, name = line.split(None, 1)
+        path = folder / name.strip()
+        if not path.is_file():
+            raise ValueError(f"{name} is listed in SHA256SUMS but missing")
+        got = sha256(path)
+        if got != digest:
+            raise ValueError(f"{name}: sha256 {got} differs from SHA256SUMS {digest}")
+        out[name.strip()] = got
+    return out
+
+
+def learned_estimate(recording, weights: str | Path):
+    """Closed-loop estimate of a Recording by the model in ``weights`` (a ``.pt`` file
+    written by :func:`save`), labelled like :func:`tiltlab.filters.estimate`."""
+    from ..filters import recordings as _rec
+
+    model, cfg, fs = load(weights)
+    seq = sequence(recording, acc_scale=cfg.acc_scale, mag_scale=cfg.mag_scale)
+    if abs(seq.fs - fs) > 1e-6 * fs:
+        raise ValueError(
+            f"the model was trained at fs = {fs:.6g} Hz; the recording has "
+            f"fs = {seq.fs:.6g} Hz (resample it, or train at its rate)"
+        )
+    q = run(model, seq, cfg)
+    like = _rec.prepare(recording).like
+    return _v.labelled(
+        quat.normalize(q),
+        like,
+        "q",
+        dims=("time", "quat"),
+        coords={"quat": list("wxyz")},
+        attrs={
+            "method": f"cnn_{cfg.variant}",
+            "units": "1",
+            "frame": "sensor->world",
+            "world_frame": "ENU",
+            "weights": Path(weights).name,
+        },
+    )
+
+
+def _compare_trial(folder: str, trial: int, fold: int, variants: list[str]):
+    """Rows of :func:`compare` for one trial (run in a worker process)."""
+    import torch
+
+    torch.set_num_threads(1)
+    rec = datasets.load_broad_trial(trial)
+    rows = []
+    for v in variants:
+        model, cfg, _ = load(Path(folder) / f"{v}_fold{fold}.pt")
+        seq = sequence(rec, acc_scale=cfg.acc_scale, mag_scale=cfg.mag_scale)
+        label = "CNN (quaternion)" if v == "quaternion" else "CNN (learned gain)"
+        rows.append(
+            {"method": label, "trial": trial} | trial_errors(run(model, seq, cfg), rec)
+        )
+    for label, (method, use_mag) in BASELINES.items():
+        q = filters.estimate(rec, method, use_mag=use_mag)
+        errs = trial_errors(q.values, rec)
+        if not use_mag:  # the heading of a 6D method is relative: tilt only
+            for key in ("heading", "total", "qae_mean", "qae_median"):
+                errs[key] = np.nan
+        rows.append({"method": label, "trial": trial} | errs)
+    return rows
+
+
+def compare(
+    folder: str | Path,
+    *,
+    trials: Seq[int] | None = None,
+    n_jobs: int = 1,
+    progress: bool = False,
+) -> pd.DataFrame:
+    """Every test trial of the committed folds: the CNN (both variants, each trial
+    estimated by the model of the fold that held it out) and the baselines of
+    :data:`BASELINES` with their default parameters, all computed now.
+
+    Parameters
+    ----------
+    folder : path
+        Output folder of :func:`cross_validate` (checked against its SHA256SUMS).
+    trials : sequence of int, optional
+        BROAD trials (default: every trial of a test fold).
+    n_jobs : int
+        Worker processes (one trial each at a time).
+    progress : bool
+        Show a progress bar.
+
+    Returns
+    -------
+    pandas.DataFrame
+        Rows (method, trial) with :func:`trial_errors` columns; the heading, total
+        and QAE of the 6D RIANN are NaN (its heading origin is arbitrary).
+    """
+    import concurrent.futures as cf
+    import multiprocessing as mp
+
+    from tqdm.auto import tqdm
+
+    folder = Path(folder)
+    check_files(folder)
+    meta = json.loads((folder / "run.json").read_text())
+    fold_of = {t: k for k, f in enumerate(meta["folds"]) for t in f}
+    variants = list(meta["configs"])
+    trials = sorted(fold_of) if trials is None else [int(t) for t in trials]
+    for t in trials:
+        if t not in fold_of:
+            raise ValueError(f"trial {t} is in no test fold of {folder}")
+    n_jobs = int(_v.integer(n_jobs, "n_jobs", minimum=1))
+    args = [(str(folder), t, fold_of[t], variants) for t in trials]
+    bar = tqdm(total=len(args), desc="trials", disable=not progress)
+    rows = []
+    if n_jobs == 1:
+        for a in args:
+            rows += _compare_trial(*a)
+            bar.update()
+    else:
+        ctx = mp.get_context("spawn")
+        with cf.ProcessPoolExecutor(n_jobs, mp_context=ctx) as pool:
+            for part in pool.map(_compare_trial, *zip(*args)):
+                rows += part
+                bar.update()
+    bar.close()
+    return pd.DataFrame(rows)

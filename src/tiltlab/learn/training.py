@@ -1,0 +1,401 @@
+r"""Training, closed-loop inference and grouped cross-validation of the learned
+orientation estimators.
+
+Everything is seeded and runs deterministically on the CPU
+(``torch.use_deterministic_algorithms``, a fixed number of threads): the same
+configuration gives the same weights bit for bit, which a test checks.
+
+Augmentations (Zaheer et al. 2023, "Data augmentation"), drawn per window:
+
+* Gaussian noise on the scaled specific force and field;
+* a static bias on each (constant over the window);
+* a random rotation of the integrator's initial orientation :math:`q_0` (angle
+  :math:`\mathcal N(0, \sigma_0)` about a random axis);
+* a random rotation :math:`c` of the sensor frame applied consistently to everything:
+  vectors :math:`b \to R(c)\,b`, orientations :math:`q \to q \otimes c^*` (so the
+  gyro-integrated window :math:`q_\omega \to q_\omega \otimes c^*`), as if the IMU had
+  been mounted differently.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import json
+import math
+import time
+from collections.abc import Callable, Sequence as Seq
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import torch
+
+from .. import _validate as _v
+from .data import Sequence, window_ends
+from .losses import LOSSES, TOTALS, qae, qmul, sample_loss, total_loss
+from .model import ACTIVATIONS, OrientationCNN
+from .optim import radam_lookahead
+
+__all__ = [
+    "TrainConfig",
+    "build_model",
+    "train",
+    "run",
+    "save",
+    "load",
+    "sha256",
+]
+
+
+@dataclass(frozen=True)
+class TrainConfig:
+    """Everything that defines a trained model (stored with its weights as JSON).
+
+    ``window_s`` is converted to a window of ``round(window_s * fs)`` samples: the
+    paper's 32 samples at 250 Hz are 0.128 s, i.e. 37 samples at BROAD's 285.7 Hz.
+    """
+
+    variant: str = "quaternion"
+    window_s: float = 0.128
+    channels: int = 32
+    kernel: int = 3
+    dilations: tuple[int, ...] = (1, 2, 4, 8)
+    activations: tuple[str, str, str] = ("gelu", "gelu", "tanh")
+    loss: str = "l2_product"
+    total: str = "L1"
+    epochs: int = 6
+    batch: int = 256
+    lr: float = 1e-3
+    lookahead_k: int = 5
+    lookahead_alpha: float = 0.5
+    stride: int = 8
+    acc_scale: float = 9.81
+    mag_scale: float = 50.0
+    noise_acc: float = 0.01
+    noise_mag: float = 0.01
+    bias_acc: float = 0.01
+    bias_mag: float = 0.02
+    init_deg: float = 8.0
+    mount_deg: float = 10.0
+    seed: int = 0
+    threads: int = 1
+
+    def __post_init__(self):
+        if self.variant not in ("quaternion", "gain"):
+            raise ValueError(
+                f"variant must be 'quaternion' or 'gain', got {self.variant!r}"
+            )
+        if self.loss not in LOSSES:
+            raise ValueError(f"loss must be one of {sorted(LOSSES)}, got {self.loss!r}")
+        if self.total not in TOTALS:
+            raise ValueError(
+                f"total must be one of {sorted(TOTALS)}, got {self.total!r}"
+            )
+        for a in self.activations:
+            if a not in ACTIVATIONS:
+                raise ValueError(
+                    f"activations must be names of {sorted(ACTIVATIONS)}, got {a!r}"
+                )
+        for name in ("window_s", "lr", "acc_scale", "mag_scale"):
+            _v.positive(getattr(self, name), name)
+        for name in ("noise_acc", "noise_mag", "bias_acc", "bias_mag", "init_deg"):
+            _v.nonnegative(getattr(self, name), name)
+        for name in ("channels", "kernel", "epochs", "batch", "stride", "threads"):
+            _v.integer(getattr(self, name), name, minimum=1)
+        _v.integer(self.seed, "seed", minimum=0)
+        object.__setattr__(self, "dilations", tuple(int(d) for d in self.dilations))
+        object.__setattr__(self, "activations", tuple(self.activations))
+
+    def window(self, fs: float) -> int:
+        return int(round(self.window_s * _v.check_fs(fs)))
+
+    def to_dict(self) -> dict[str, Any]:
+        return dataclasses.asdict(self)
+
+    @classmethod
+    def from_dict(cls, d: dict[str, Any]) -> TrainConfig:
+        d = dict(d)
+        d["dilations"] = tuple(d["dilations"])
+        d["activations"] = tuple(d["activations"])
+        return cls(**d)
+
+
+def build_model(config: TrainConfig, fs: float) -> OrientationCNN:
+    return OrientationCNN(
+        config.window(fs),
+        variant=config.variant,
+        channels=config.channels,
+        kernel=config.kernel,
+        dilations=config.dilations,
+        activations=config.activations,
+    )
+
+
+# ---------------------------------------------------------------- batches
+
+
+class _Stack:
+    """Training sequences concatenated, as tensors, with the valid window ends."""
+
+    def __init__(self, seqs: Seq[Sequence], window: int, stride: int):
+        self.window = window
+        offs, ends = 0, []
+        for s in seqs:
+            ends.append(window_ends(s, window, stride) + offs)
+            offs += len(s)
+
+        def cat(name: str) -> torch.Tensor:
+            return torch.from_numpy(np.concatenate([getattr(s, name) for s in seqs]))
+
+        self.Q, self.acc, self.mag = cat("Q"), cat("acc"), cat("mag")
+        self.q_vec, self.q_ref = cat("q_vec"), cat("q_ref")
+        self.ends = torch.from_numpy(np.concatenate(ends))
+
+
+def _conj(q: torch.Tensor) -> torch.Tensor:
+    return q * torch.tensor([1.0, -1.0, -1.0, -1.0])
+
+
+def _axis_angle(axis: torch.Tensor, angle: torch.Tensor) -> torch.Tensor:
+    axis = axis / axis.norm(dim=-1, keepdim=True).clamp_min(1e-12)
+    return torch.cat(
+        [torch.cos(angle / 2)[:, None], torch.sin(angle / 2)[:, None] * axis], dim=-1
+    )
+
+
+def _rotate(q: torch.Tensor, v: torch.Tensor) -> torch.Tensor:
+    """Rotate vectors v (B, T, 3) by quaternions q (B, 4)."""
+    qv = torch.cat([torch.zeros_like(v[..., :1]), v], dim=-1)
+    qq = q[:, None, :].expand(-1, v.shape[1], -1)
+    return qmul(qmul(qq, qv), _conj(qq))[..., 1:]
+
+
+def _canonical(q: torch.Tensor) -> torch.Tensor:
+    return torch.where(q[..., :1] < 0, -q, q)
+
+
+def _indices(ends: torch.Tensor, window: int) -> torch.Tensor:
+    """(B, T) sample indices of the windows ending at ``ends``."""
+    return ends[:, None] + torch.arange(-window + 1, 1)[None, :]
+
+
+def _inputs(
+    Q: torch.Tensor,
+    acc_w: torch.Tensor,
+    mag_w: torch.Tensor,
+    ends: torch.Tensor,
+    q0: torch.Tensor,
+    window: int,
+) -> torch.Tensor:
+    """(B, 10, T) network inputs for windows ending at ``ends`` (windowed ``acc_w`` and
+    ``mag_w``, (B, T, 3)) from initial orientations ``q0`` (B, 4) at ``ends - window``."""
+    dq = qmul(_conj(Q[ends - window])[:, None, :], Q[_indices(ends, window)])
+    q_w = qmul(_canonical(q0)[:, None, :], dq)
+    return torch.cat([q_w, acc_w, mag_w], dim=-1).transpose(1, 2)
+
+
+def _batch(stack: _Stack, ends: torch.Tensor, cfg: TrainConfig, g: torch.Generator):
+    """Augmented inputs, q_vec and targets for one batch."""
+    w = stack.window
+    n = ends.numel()
+    k = _indices(ends, w)
+
+    def gauss(*shape, scale):
+        return torch.randn(*shape, generator=g) * scale
+
+    ang0 = gauss(n, scale=math.radians(cfg.init_deg))
+    noise0 = _axis_angle(gauss(n, 3, scale=1.0), ang0)
+    q0 = qmul(noise0, stack.q_ref[ends - w])
+    acc = (
+        stack.acc[k]
+        + gauss(n, w, 3, scale=cfg.noise_acc)
+        + gauss(n, 1, 3, scale=cfg.bias_acc)
+    )
+    mag = (
+        stack.mag[k]
+        + gauss(n, w, 3, scale=cfg.noise_mag)
+        + gauss(n, 1, 3, scale=cfg.bias_mag)
+    )
+    x = _inputs(stack.Q, acc, mag, ends, q0, w)
+    target = stack.q_ref[ends]
+    q_vec = stack.q_vec[ends]
+    if cfg.mount_deg > 0:
+        c = _axis_angle(
+            gauss(n, 3, scale=1.0), gauss(n, scale=math.radians(cfg.mount_deg))
+        )
+        cc = _conj(c)
+        q_w = qmul(x[:, :4, :].transpose(1, 2), cc[:, None, :])
+        x = torch.cat([q_w, _rotate(c, acc), _rotate(c, mag)], dim=-1).transpose(1, 2)
+        target = qmul(target, cc)
+        q_vec = qmul(q_vec, cc)
+    return x.contiguous(), q_vec, target
+
+
+# ---------------------------------------------------------------- training
+
+
+def _seed(cfg: TrainConfig) -> torch.Generator:
+    torch.manual_seed(cfg.seed)
+    torch.set_num_threads(cfg.threads)
+    torch.use_deterministic_algorithms(True)
+    g = torch.Generator()
+    g.manual_seed(cfg.seed)
+    return g
+
+
+def train(
+    sequences: Seq[Sequence],
+    config: TrainConfig,
+    *,
+    max_steps: int | None = None,
+    progress: Callable[[str], None] | None = None,
+) -> tuple[OrientationCNN, list[dict[str, float]]]:
+    """Train a model on ``sequences`` (each with ``q_ref``).
+
+    Parameters
+    ----------
+    sequences : sequence of Sequence
+        Training data (:func:`tiltlab.learn.sequence`), all at the same ``fs``.
+    config : TrainConfig
+    max_steps : int, optional
+        Stop after this many optimiser steps (tests, quick looks).
+    progress : callable, optional
+        Called with one line per epoch.
+
+    Returns
+    -------
+    model : OrientationCNN
+        In evaluation mode.
+    history : list of dict
+        Per epoch: ``epoch``, ``loss`` (mean total loss per batch), ``qae_deg`` (mean
+        QAE of the training windows, degrees), ``seconds``.
+    """
+    if not sequences:
+        raise ValueError("sequences is empty")
+    fs = sequences[0].fs
+    if any(abs(s.fs - fs) > 1e-9 * fs for s in sequences):
+        raise ValueError("all training sequences must have the same fs")
+    g = _seed(config)
+    window = config.window(fs)
+    stack = _Stack(sequences, window, config.stride)
+    if stack.ends.numel() == 0:
+        raise ValueError("no training window has a valid reference at both ends")
+    model = build_model(config, fs)
+    opt = radam_lookahead(
+        model.parameters(),
+        lr=config.lr,
+        k=config.lookahead_k,
+        alpha=config.lookahead_alpha,
+    )
+    history: list[dict[str, float]] = []
+    steps = 0
+    for epoch in range(config.epochs):
+        model.train()
+        t0 = time.perf_counter()
+        order = stack.ends[torch.randperm(stack.ends.numel(), generator=g)]
+        losses, errs = [], []
+        for b in range(0, order.numel(), config.batch):
+            ends = order[b : b + config.batch]
+            if ends.numel() < 2:
+                continue
+            x, q_vec, target = _batch(stack, ends, config, g)
+            out = model(x, q_vec)
+            loss = total_loss(sample_loss(target, out, config.loss), config.total)
+            opt.zero_grad()
+            loss.backward()
+            opt.step()
+            losses.append(float(loss.detach()))
+            errs.append(float(qae(target, out.detach()).mean()))
+            steps += 1
+            if max_steps is not None and steps >= max_steps:
+                break
+        history.append(
+            {
+                "epoch": epoch + 1,
+                "loss": float(np.mean(losses)),
+                "qae_deg": math.degrees(float(np.mean(errs))),
+                "seconds": time.perf_counter() - t0,
+            }
+        )
+        if progress is not None:
+            h = history[-1]
+            progress(
+                f"epoch {epoch + 1}/{config.epochs}: loss {h['loss']:.4g}, "
+                f"QAE {h['qae_deg']:.2f} deg, {h['seconds']:.0f} s"
+            )
+        if max_steps is not None and steps >= max_steps:
+            break
+    model.eval()
+    return model, history
+
+
+# ---------------------------------------------------------------- inference
+
+
+@torch.no_grad()
+def run(model: OrientationCNN, seq: Sequence, config: TrainConfig) -> np.ndarray:
+    r"""Closed-loop estimate of a whole sequence, (N, 4) float64.
+
+    The first :math:`T` samples integrate the gyroscope from the vector-observation
+    orientation of the first window (QUEST initialisation); from then on, the estimate
+    at :math:`t` is the network's output for the window starting at :math:`t-T` with
+    the integrator started from its own estimate there. Windows are evaluated in
+    blocks of :math:`T` consecutive outputs, one batch per block.
+    """
+    model.eval()
+    window = config.window(seq.fs)
+    n = len(seq)
+    Q = torch.from_numpy(seq.Q)
+    acc, mag = torch.from_numpy(seq.acc), torch.from_numpy(seq.mag)
+    q_vec = torch.from_numpy(seq.q_vec)
+    out = torch.empty(n, 4)
+    head = min(n, window + 1)
+    q_init = _canonical(q_vec[:head].mean(0, keepdim=True))
+    q_init = q_init / q_init.norm()
+    out[:head] = qmul(q_init, qmul(_conj(Q[:1]), Q[:head]))
+    for b in range(head, n, window):
+        ends = torch.arange(b, min(b + window, n))
+        k = _indices(ends, window)
+        x = _inputs(Q, acc[k], mag[k], ends, out[ends - window], window)
+        out[ends] = model(x, q_vec[ends])
+    return _canonical(out).double().numpy()
+
+
+# ---------------------------------------------------------------- files
+
+
+def sha256(path: str | Path) -> str:
+    h = hashlib.sha256()
+    with open(path, "rb") as f:
+        for chunk in iter(lambda: f.read(1 << 20), b""):
+            h.update(chunk)
+    return h.hexdigest()
+
+
+def save(
+    model: OrientationCNN, config: TrainConfig, fs: float, path: str | Path
+) -> str:
+    """Write the weights (``path``, a ``.pt`` state dict) and return their sha256."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    torch.save(
+        {"state": model.state_dict(), "config": config.to_dict(), "fs": float(fs)}, path
+    )
+    return sha256(path)
+
+
+def load(path: str | Path) -> tuple[OrientationCNN, TrainConfig, float]:
+    """Read weights written by :func:`save`: the model (evaluation mode), its
+    configuration and the sampling rate it was trained at."""
+    blob = torch.load(Path(path), map_location="cpu", weights_only=True)
+    cfg = TrainConfig.from_dict(blob["config"])
+    model = build_model(cfg, blob["fs"])
+    model.load_state_dict(blob["state"])
+    model.eval()
+    return model, cfg, float(blob["fs"])
+
+
+def write_json(obj: Any, path: str | Path) -> None:
+    Path(path).write_text(json.dumps(obj, indent=1, sort_keys=True) + "\n")

@@ -1,0 +1,119 @@
+"""Figures of the learned estimators: training curves and per-trial errors by method.
+
+Inputs are plain data (the ``history.json`` mapping and the table of
+:func:`tiltlab.learn.compare`), so this module needs no PyTorch.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+
+import matplotlib.pyplot as plt
+import numpy as np
+import pandas as pd
+
+from ._common import label, new_axes
+
+__all__ = ["learning_curves", "method_strips"]
+
+
+def learning_curves(
+    history: Mapping[str, Sequence[Mapping[str, float]]],
+    *,
+    key: str = "qae_deg",
+    figsize=(9, 3.5),
+):
+    """Training curves: ``key`` per epoch, one line per fold, one panel per variant.
+
+    Parameters
+    ----------
+    history : mapping
+        ``"<variant>/fold<k>" -> [{"epoch": ..., key: ...}, ...]`` (``history.json``).
+    key : str
+        ``"qae_deg"`` (mean QAE of the training windows, degrees) or ``"loss"``.
+    figsize : (float, float)
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    variants = sorted({name.split("/")[0] for name in history})
+    fig, axes = plt.subplots(
+        1, len(variants), figsize=figsize, sharey=True, squeeze=False
+    )
+    for ax, variant in zip(axes[0], variants, strict=True):
+        for name, rows in sorted(history.items()):
+            if name.split("/")[0] != variant:
+                continue
+            epochs = [r["epoch"] for r in rows]
+            ax.plot(
+                epochs, [r[key] for r in rows], marker="o", label=name.split("/")[1]
+            )
+        ax.set_title(variant)
+        ax.set_xlabel("epoch")
+        ax.legend(title="model", fontsize=8, frameon=False)
+    axes[0, 0].set_ylabel(
+        label("training QAE", "deg") if key == "qae_deg" else "training loss"
+    )
+    fig.tight_layout()
+    return fig
+
+
+def method_strips(
+    table: pd.DataFrame,
+    metric: str = "inclination",
+    *,
+    hue: Mapping[int, str] | None = None,
+    logy: bool = True,
+    ax=None,
+    figsize=(9, 4),
+):
+    """Per-trial errors as dots, one column per method, with each method's median.
+
+    Parameters
+    ----------
+    table : pandas.DataFrame
+        Rows with ``method``, ``trial`` and ``metric`` (degrees).
+    metric : str
+        Column to show.
+    hue : mapping, optional
+        Trial → group label (e.g. "undisturbed" / "disturbed"), coloured separately.
+    logy : bool
+    ax : matplotlib.axes.Axes, optional
+    figsize : (float, float)
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+    """
+    ax = new_axes(ax, figsize=figsize)
+    methods = list(dict.fromkeys(table["method"]))
+    groups = sorted(set(hue.values())) if hue else [None]
+    colours = dict(zip(groups, plt.rcParams["axes.prop_cycle"].by_key()["color"]))
+    rng = np.random.default_rng(0)
+    for i, m in enumerate(methods):
+        rows = table[table["method"] == m].dropna(subset=[metric])
+        for g in groups:
+            sel = rows if g is None else rows[[hue.get(t) == g for t in rows["trial"]]]
+            x = i + rng.uniform(-0.18, 0.18, len(sel))
+            ax.scatter(
+                x,
+                sel[metric],
+                s=14,
+                color=colours[g],
+                alpha=0.8,
+                label=g if (i == 0 and g is not None) else None,
+            )
+        if len(rows):
+            med = float(np.median(rows[metric]))
+            ax.plot([i - 0.3, i + 0.3], [med, med], color="k", lw=2)
+    ax.set_xticks(range(len(methods)), methods, rotation=20, ha="right")
+    ax.set_ylabel(
+        label(f"{metric} RMSE per trial" + (", log scale" if logy else ""), "deg")
+    )
+    if logy:
+        ax.set_yscale("log")
+    if hue:
+        ax.legend(title="trial", fontsize=8, frameon=False)
+    ax.grid(axis="y", alpha=0.3)
+    return ax
