@@ -116,8 +116,29 @@ def check_cohort_tables(nb_path: Path, params: dict) -> str:
     return f"{tables} tables, {tests} tests on {groups} groups × {post} time points"
 
 
+def check_learned_trials(nb_path: Path, params: dict) -> str:
+    """The learned-estimator chapter compared every method on exactly the trials asked."""
+    found = _printed(
+        nb_path, r"compared (\d+) methods on (\d+) held-out trials: \[([0-9, ]*)\]"
+    )
+    if not found:
+        raise AssertionError("the chapter printed no comparison line")
+    n_methods, _, listed = found[0]
+    trials = sorted(int(t) for t in listed.split(",") if t.strip())
+    if trials != sorted(params["TRIALS"]):
+        raise AssertionError(
+            f"chapter compared trials {trials}, asked {params['TRIALS']}"
+        )
+    return f"{n_methods} methods on trials {trials}"
+
+
 # (notebook, parameters or prepare(tmp) -> parameters, optional check)
 RERUNS = [
+    (
+        "05_learned_orientation",
+        {"TRIALS": [6, 28], "EXAMPLE_TRIAL": 6, "SOURCE": "broad:10", "N_JOBS": 1},
+        check_learned_trials,
+    ),
     (
         "06_tilt_maps_sphere",
         {"SOURCE": "broad:2", "IMMOBILE_DEG_S": 12.0},
