@@ -28,6 +28,7 @@ from .losses import LOSSES, TOTALS, qae, sample_loss, total_loss
 from .model import ACTIVATIONS, OrientationCNN
 from .optim import Lookahead, radam_lookahead
 from .training import TrainConfig, build_model, load, run, save, sha256, train
+from .published import ZAHEER_TABLE2, ZAHEER_TABLE3
 from .cv import BASELINES, check_files, compare, cross_validate, folds, learned_estimate
 
 __all__ = [
@@ -56,4 +57,6 @@ __all__ = [
     "cross_validate",
     "folds",
     "learned_estimate",
+    "ZAHEER_TABLE2",
+    "ZAHEER_TABLE3",
 ]
