@@ -137,8 +137,9 @@ def main() -> None:
             print(f"{name:18s} {r_ours / 1e6:22.2f} {'-':>19s} {'-':>8s}")
         rows.append((name, r_ours))
 
-    # ---- offline methods (6D): the error-state RTS smoother stores a 15x15 covariance per
-    # sample (1.8 kB), so it runs on at most --n-offline samples; offlineVQF in the same run
+    # ---- offline methods (6D): the error-state RTS smoother (checkpointed backward pass,
+    # bounded memory) runs on at most --n-offline samples to keep this benchmark short;
+    # offlineVQF in the same run
     no = min(n, args.n_offline)
     a_o, g_o = acc[:no], gyr[:no]
     F.rts_smoother(a_o[:200], g_o[:200], fs)  # warm-up

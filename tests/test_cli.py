@@ -107,7 +107,10 @@ def test_csv_without_mapping_says_how_to_give_one(tmp_path, capsys):
             ),
             "missing column(s) 'AZ' (mapped to acc), did you mean 'az'?; available columns: 't_ms', 'ax'",
         ),
-        (json.dumps({**MAPPING, "time_units": "s"}), "is the time column in ms?"),
+        (
+            json.dumps({**MAPPING, "time_units": "s"}),
+            "the time column looks like milliseconds: give time_units='ms'",
+        ),
     ],
 )
 def test_csv_user_errors_are_one_line(tmp_path, capsys, mapping, expected):

@@ -9,6 +9,7 @@ import xarray as xr
 from tiltlab import io, schema
 from tiltlab import quaternion as Q
 from tiltlab.io import ReadError
+from tiltlab.quality import QualityWarning
 
 
 @pytest.fixture(scope="module")
@@ -28,8 +29,11 @@ def test_read_fayat_example(fayat_dir):
 
 
 def test_read_fayat_tumble(fayat_dir):
-    rec = io.read_fayat_tumble(fayat_dir / "example_sensor_calibration.csv")
+    # the MPU9250 was set to ±4 g, ±1000 deg/s, and clipped while turned over
+    with pytest.warns(QualityWarning, match="clipped at its full scale"):
+        rec = io.read_fayat_tumble(fayat_dir / "example_sensor_calibration.csv")
     assert rec.attrs["fs"] == 300.0 and rec.sizes["time"] == 30543
+    assert rec.acc.attrs["range"] == 4.0 and rec.gyr.attrs["range"] == 1000.0
     np.testing.assert_allclose(np.diff(rec.time.values), 1 / 300, rtol=1e-6)
 
 
@@ -336,3 +340,47 @@ def test_csv_mapping_errors(tmp_path):
         io.read_csv_mapping({"columns": MAPPING["columns"], "units": MAPPING["units"]})
     with pytest.raises(ValueError, match="pandas.read_csv does not take"):
         io.read_csv_mapping({**MAPPING, "read_csv": {"nope": 1}})
+
+
+@pytest.mark.parametrize(
+    ("factor", "unit", "name", "given"),
+    [
+        (1e3, "ms", "milliseconds", None),
+        (1e6, "us", "microseconds", None),
+        (1.0, "s", "seconds", "ms"),  # seconds declared as ms: 30 kHz
+    ],
+)
+def test_csv_time_unit_hint_names_the_unit(tmp_path, factor, unit, name, given):
+    p = tmp_path / "s.csv"
+    _lab_csv(p, fs=100.0, time_factor=factor)
+    m = {k: v for k, v in MAPPING.items() if k != "time_units"}
+    if given:
+        m["time_units"] = given
+    expected = f"the time column looks like {name}: give time_units='{unit}'"
+    with pytest.raises(ValueError, match=rf"outside the plausible range.*{expected}"):
+        io.read_csv(p, mapping=m)
+    with pytest.raises(ValueError, match=rf"fs = 100 Hz but .*{expected}"):
+        io.read_csv(p, mapping={**m, "fs": 100})
+    rec = io.read_csv(p, mapping={**m, "time_units": unit})
+    assert rec.attrs["fs"] == pytest.approx(100.0)
+
+
+def test_csv_full_scale_from_the_mapping(tmp_path):
+    p = tmp_path / "s.csv"
+    _lab_csv(p)
+    rec = io.read_csv(
+        p, mapping={**MAPPING, "range": {"acc": 16, "gyr": [-2000, 2000]}}
+    )
+    assert rec.acc.attrs["range"] == 16.0 and rec.gyr.attrs["range"] == 2000.0
+    rec = io.read_csv(p, mapping=MAPPING, range={"gyr": 250})
+    assert rec.gyr.attrs["range"] == 250.0 and "range" not in rec.acc.attrs
+    with pytest.raises(
+        ValueError, match=r"range\['gyr'\] must be a positive full scale"
+    ):
+        io.read_csv_mapping({**MAPPING, "range": {"gyr": -1}})
+    with pytest.raises(ValueError, match=r"range\['temp'\]: a full scale is given for"):
+        io.read_csv_mapping({**MAPPING, "range": {"temp": 100}})
+    with pytest.raises(ValueError, match=r"range\['mag'\] is given but 'mag' is not"):
+        io.read_csv_mapping({**MAPPING, "range": {"mag": 4900}})
+    with pytest.raises(ValueError, match="'range' must map variables"):
+        io.read_csv_mapping({**MAPPING, "range": 16})

@@ -321,13 +321,22 @@ def test_kde_equals_direct_sum_of_vmf_kernels():
     w = rng.random(40)
     grid = S.equal_area_grid(5.0, pole=[0.3, -0.2, 1.0])
     h = 0.2
-    res = S.kde(x, grid=grid, h=h, weights=w, tol=1e-14)
+    res = S.kde(x, grid=grid, h=h, weights=w, tol=1e-14, quadrature="point")
     c = grid.centres().reshape(-1, 3)
-    direct = np.array([S.vmf_pdf(c, xi, 1 / h**2) for xi in x]).T @ w / w.sum()
+    kernels = np.array([S.vmf_pdf(c, xi, 1 / h**2) for xi in x]).T
+    direct = kernels @ w / w.sum()
     np.testing.assert_allclose(res.density.ravel(), direct, rtol=1e-9, atol=1e-12)
-    g = S.kde(x, grid=grid, h=h, weights=w, kernel="gauss", tol=1e-14)
+    g = S.kde(
+        x, grid=grid, h=h, weights=w, kernel="gauss", tol=1e-14, quadrature="point"
+    )
     np.testing.assert_allclose(
         g.density, res.density / (1 - np.exp(-2 / h**2)), rtol=1e-12
+    )
+    # default quadrature="mass": the same kernels, each rescaled to unit mass on the grid
+    mass = S.kde(x, grid=grid, h=h, weights=w, tol=1e-14)
+    unit_mass = kernels / (kernels.sum(axis=0) * grid.cell_area)
+    np.testing.assert_allclose(
+        mass.density.ravel(), unit_mass @ w / w.sum(), rtol=1e-9, atol=1e-12
     )
 
 

@@ -426,3 +426,130 @@ def windowed(values, like: Signal, name: str, *, centre_s, fs_out: float, units=
 
 # imported last: tiltlab.units re-exports check_fs from this module
 from . import units as _units  # noqa: E402
+
+
+# --------------------------------------------------------------------------- time gaps
+#
+# A time axis with dropped samples (a step longer than ``(1 + tolerance) / fs``) or rows
+# of non-finite samples breaks a recording into contiguous segments. :func:`signal` does
+# not look for them (its ``time``/``fs`` check compares the *median* step with ``1/fs``,
+# so a few long steps pass); functions that integrate over time (the orientation
+# filters) call :func:`segments` and either refuse the recording (error, with
+# :func:`describe_gaps` in the message) or process each segment on its own.
+
+__all__ += ["segments", "describe_gaps"]
+
+
+def _gap_time(time, name: str = "time") -> np.ndarray:
+    t = vectors(time, name, width=None, ndim=1)
+    if t.size >= 2 and np.any(np.diff(t) <= 0):
+        i = int(np.argmax(np.diff(t) <= 0))
+        raise RecordingError(
+            f"{name} is not strictly increasing (at sample {i + 1}: "
+            f"{t[i]:g} → {t[i + 1]:g} s)"
+        )
+    return t
+
+
+def segments(time, fs, *, values=None, tolerance: float = 0.5) -> list[tuple[int, int]]:
+    """Contiguous runs of valid samples, as ``[start, stop)`` index ranges.
+
+    A new segment starts where the time step exceeds ``(1 + tolerance) / fs`` (dropped
+    samples) and around every row of ``values`` that has a non-finite entry (such rows
+    belong to no segment).
+
+    Parameters
+    ----------
+    time : array_like, shape (N,)
+        Sample times (s), strictly increasing.
+    fs : float
+        Nominal sampling rate (Hz).
+    values : array_like, shape (N, ...), optional
+        Samples whose rows must be finite (e.g. ``acc``, ``gyr`` and ``mag`` stacked
+        side by side as an (N, 9) array).
+    tolerance : float
+        Accepted lengthening of a step, as a fraction of ``1/fs`` (default 0.5: a
+        single dropped sample, a step of ``2/fs``, is a gap).
+
+    Returns
+    -------
+    list of (int, int)
+        ``(start, stop)`` pairs in increasing order; ``[(0, N)]`` for a gap-free,
+        finite recording, ``[]`` when no sample is valid.
+
+    Raises
+    ------
+    ValueError
+        An invalid ``fs`` or ``tolerance``, a ``time`` that is not a finite 1-D array,
+        or ``values`` whose first dimension is not N.
+    RecordingError
+        A ``time`` that is not strictly increasing.
+    """
+    fs = check_fs(fs)
+    tolerance = nonnegative(tolerance, "tolerance")
+    t = _gap_time(time)
+    n = t.size
+    if values is None:
+        ok = np.ones(n, dtype=bool)
+    else:
+        v = np.asarray(values, dtype=float)
+        if v.ndim == 0 or v.shape[0] != n:
+            raise ValueError(
+                f"values must have {n} rows (one per time sample), got shape {v.shape}"
+            )
+        ok = np.isfinite(v.reshape(n, -1)).all(axis=1) if n else np.ones(0, bool)
+    if n == 0:
+        return []
+    jump = np.zeros(n, dtype=bool)
+    jump[1:] = np.diff(t) > (1.0 + tolerance) / fs
+    prev_ok = np.concatenate([[False], ok[:-1]])
+    next_ok = np.concatenate([ok[1:], [False]])
+    next_jump = np.concatenate([jump[1:], [True]])
+    starts = np.flatnonzero(ok & (~prev_ok | jump))
+    stops = np.flatnonzero(ok & (~next_ok | next_jump)) + 1
+    return [(int(a), int(b)) for a, b in zip(starts, stops)]
+
+
+def describe_gaps(time, fs, segs, *, tolerance: float = 0.5, max_items: int = 5) -> str:
+    """A short sentence describing the gaps around ``segs`` (from :func:`segments`).
+
+    Each gap is given by its duration (time without valid samples, beyond a normal
+    step) and the time of its first missing sample, e.g. ``"2 gaps: 1.00 s at t =
+    12.30 s (time jump), 0.05 s at t = 20.00 s (5 non-finite samples)"``; at most
+    ``max_items`` are listed. ``"no gaps"`` when ``segs`` covers every sample.
+    """
+    fs = check_fs(fs)
+    tolerance = nonnegative(tolerance, "tolerance")
+    t = _gap_time(time)
+    n = t.size
+    dt = 1.0 / fs
+    if n == 0:
+        return "no samples"
+    if not segs:
+        return f"no valid samples (all {n} samples have non-finite values)"
+    items = []  # (start time, duration, n non-finite, time jump)
+    a0 = segs[0][0]
+    if a0 > 0:
+        items.append((t[0], t[a0] - t[0], a0, False))
+    for (_, b), (a, _) in zip(segs[:-1], segs[1:]):
+        jump = bool(np.any(np.diff(t[b - 1 : a + 1]) > (1.0 + tolerance) * dt))
+        items.append((t[b - 1] + dt, t[a] - t[b - 1] - dt, a - b, jump))
+    b1 = segs[-1][1]
+    if b1 < n:
+        items.append((t[b1 - 1] + dt, t[-1] - t[b1 - 1], n - b1, False))
+    if not items:
+        return "no gaps"
+
+    def why(k: int, jump: bool) -> str:
+        parts = (["time jump"] if jump else []) + (
+            [f"{k} non-finite sample{'s' if k != 1 else ''}"] if k else []
+        )
+        return " and ".join(parts)
+
+    shown = [
+        f"{d:.2f} s at t = {s:.2f} s ({why(k, j)})" for s, d, k, j in items[:max_items]
+    ]
+    more = len(items) - len(shown)
+    tail = f", and {more} more" if more else ""
+    word = "gap" if len(items) == 1 else "gaps"
+    return f"{len(items)} {word}: " + ", ".join(shown) + tail

@@ -14,15 +14,20 @@ Examples
 
 Every user error (missing file, bad JSON, bad mapping, a Recording that breaks the
 contract) is reported as one line ``tiltlab: ...`` on stderr with a non-zero exit
-status, never as a traceback (set ``TILTLAB_DEBUG=1`` to see one).
+status, never as a traceback (set ``TILTLAB_DEBUG=1`` to see one). Quality warnings
+(clipped samples, values doubtful for their units: :mod:`tiltlab.quality`) are printed
+by ``tiltlab validate`` as lines ``warning: ...`` before its verdict, and leave the exit
+status 0.
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 import os
 import sys
+import warnings
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
@@ -155,16 +160,50 @@ def _cmd_fetch(args: argparse.Namespace, parser: argparse.ArgumentParser) -> int
         parser.error("give file names or --all")
     from tqdm import tqdm
 
+    known = datasets.registry()
+    unknown = [n for n in names if n not in known]
+    if unknown:
+        raise datasets.DataError(f"{unknown[0]!r} is not in the tiltlab data registry")
     for name in tqdm(names, desc="fetching", unit="file"):
         datasets.fetch(name)
     print(f"{len(names)} file(s) present and verified")
     return EXIT_OK
 
 
+@contextlib.contextmanager
+def _quality_lines(emit):
+    """Collect the warnings of tiltlab (quality warnings and any other warning raised in
+    the package) while the block runs, and hand each distinct message, in order, to
+    ``emit`` when it ends — also when it ends by an error. Other warnings (libraries')
+    are shown as usual."""
+    package = str(Path(__file__).resolve().parent)
+    lines: list[str] = []
+    try:
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            yield lines
+    finally:
+        from .quality import QualityWarning
+
+        for w in caught:
+            mine = issubclass(w.category, QualityWarning) or str(
+                Path(w.filename).resolve()
+            ).startswith(package)
+            if not mine:
+                warnings.showwarning(w.message, w.category, w.filename, w.lineno)
+                continue
+            text = " ".join(str(w.message).split())
+            if text not in lines:
+                lines.append(text)
+        for text in lines:
+            emit(text)
+
+
 def _cmd_info(args: argparse.Namespace) -> int:
     from . import schema
 
-    rec = _load(args.source, args.mapping, cmd="info")
+    with _quality_lines(lambda t: print(f"tiltlab: warning: {t}", file=sys.stderr)):
+        rec = _load(args.source, args.mapping, cmd="info")
     for k, v in schema.describe(rec).items():
         print(f"{k:>14}: {v}")
     if "fs_source" in rec.attrs:
@@ -175,9 +214,16 @@ def _cmd_info(args: argparse.Namespace) -> int:
 def _cmd_validate(args: argparse.Namespace) -> int:
     from . import schema
 
-    rec = _load(args.source, args.mapping, cmd="validate")
-    schema.validate(rec, allow_nan=True)
-    print(f"{args.source}: valid Recording")
+    # quality warnings are part of the report (stdout), one line each; they do not
+    # change the exit status, errors do (one line on stderr, from main)
+    with _quality_lines(lambda t: print(f"warning: {t}")) as lines:
+        rec = _load(args.source, args.mapping, cmd="validate")
+        schema.validate(rec, allow_nan=True)
+    n = len(lines)
+    print(
+        f"{args.source}: valid Recording"
+        + (f" ({n} warning{'s' if n > 1 else ''})" if n else "")
+    )
     return EXIT_OK
 
 

@@ -241,6 +241,11 @@ def load(source: str | os.PathLike) -> xr.Dataset:
     DataError
         If the source is neither a known name nor a readable file type.
     """
+    if not isinstance(source, (str, os.PathLike)):
+        raise DataError(
+            f"source must be a data-source string (broad:N, fayat:example, "
+            f"fayat:tumble) or a file path, got {source!r}"
+        )
     spec = os.fspath(source)
     if spec.startswith("broad:"):
         trial = spec.split(":", 1)[1]

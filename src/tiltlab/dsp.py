@@ -36,7 +36,8 @@ def window_samples(
     """Number of samples in a window of ``window_s`` seconds at ``fs`` (rounded, ≥ ``minimum``)."""
     window_s = _v.positive(window_s, name)
     fs = _v.check_fs(fs)
-    return max(int(round(window_s * fs)), int(minimum))
+    minimum = _v.integer(minimum, "minimum", minimum=1)
+    return max(int(round(window_s * fs)), minimum)
 
 
 def lowpass(
@@ -90,7 +91,10 @@ def lowpass(
 def moving_mean(x, n: int) -> np.ndarray:
     """Centred running mean over ``n`` samples along the first axis (``nearest`` edges)."""
     n = _v.integer(n, "n", minimum=1)
-    return uniform_filter1d(np.asarray(x, dtype=float), n, axis=0, mode="nearest")
+    x = _v.vectors(x, "x", width=None, ndim=None)
+    if x.ndim == 0:
+        raise ValueError("x must have a time dimension, got a scalar")
+    return uniform_filter1d(x, n, axis=0, mode="nearest")
 
 
 def moving_std(x, n: int) -> np.ndarray:
@@ -99,7 +103,7 @@ def moving_std(x, n: int) -> np.ndarray:
     :math:`\sqrt{\max(\overline{x^2} - \bar x^2, 0)}` (clipped: the running mean of tiny
     squares can round below the squared mean).
     """
-    x = np.asarray(x, dtype=float)
+    x = _v.vectors(x, "x", width=None, ndim=1)
     m1 = moving_mean(x, n)
     m2 = moving_mean(x * x, n)
     return np.sqrt(np.maximum(m2 - m1 * m1, 0.0))
@@ -149,6 +153,11 @@ def still_mask(
     """
     fs = _v.check_fs(fs)
     s = _v.vectors(speed, "speed", width=None, ndim=1)
+    if np.any(s < 0):
+        raise ValueError(
+            f"speed must be non-negative, got {int(np.sum(s < 0))} negative values "
+            f"(min {float(s.min()):g})"
+        )
     threshold = _v.positive(threshold, "threshold")
     smooth_s = _v.nonnegative(smooth_s, "smooth_s")
     merge_gap_s = _v.nonnegative(merge_gap_s, "merge_gap_s")

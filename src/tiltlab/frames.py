@@ -19,6 +19,11 @@ modules share and that must not be implemented twice.
 * **Marker head frame** — the head frame defined by three motion-capture markers
   (Fayat §2.6.4, :func:`head_frame_from_markers`).
 
+Inputs are checked (:class:`ValueError` naming the argument): NaN angles and vectors
+(missing samples) propagate, but infinite angles, zero vectors where a direction is
+needed (``acc_rest``, ``g``), coincident or collinear markers, non-unit quaternions and
+matrices that are not rotations (reflections included) are errors.
+
 References
 ----------
 .. [1] S. Benhamou, "Inferring the 3D orientation of a body from its acceleration and
@@ -34,6 +39,7 @@ from typing import Literal, NamedTuple
 
 import numpy as np
 
+from . import _validate as _v
 from . import quaternion as _quat
 
 __all__ = [
@@ -87,13 +93,38 @@ def _vec3(a, name: str) -> np.ndarray:
     return a
 
 
+def _angle(a, name: str) -> np.ndarray:
+    """Angles (rad) as floats; NaN (undefined) passes, an infinite angle raises."""
+    a = np.asarray(a, dtype=float)
+    if np.any(np.isinf(a)):
+        raise ValueError(f"{name} has {int(np.sum(np.isinf(a)))} infinite values")
+    return a
+
+
+def _convention(convention) -> str:
+    if convention not in ("tiltlab", "benhamou"):
+        raise ValueError(
+            f"convention must be 'tiltlab' or 'benhamou', got {convention!r}"
+        )
+    return convention
+
+
 def _as_benhamou(acc, convention: Convention, name: str = "acc") -> np.ndarray:
     acc = _vec3(acc, name)
-    if convention == "tiltlab":
+    if _convention(convention) == "tiltlab":
         return -acc
-    if convention == "benhamou":
-        return acc.copy()
-    raise ValueError(f"convention must be 'tiltlab' or 'benhamou', got {convention!r}")
+    return acc.copy()
+
+
+def _nonzero(a: np.ndarray, name: str, what: str = "vector") -> np.ndarray:
+    """``a`` (…, 3) unchanged; a zero (finite) vector, which has no direction, raises."""
+    n = np.linalg.norm(a, axis=-1)
+    if np.any(n == 0):
+        k = int(np.sum(n == 0))
+        raise ValueError(
+            f"{name} has {k} zero {what}{'s' if k > 1 else ''}: its direction is undefined"
+        )
+    return a
 
 
 def _clip1(x):
@@ -102,7 +133,7 @@ def _clip1(x):
 
 def wrap_angle(angle) -> np.ndarray:
     """Wrap angles (rad) to (−π, π]."""
-    a = np.asarray(angle, dtype=float)
+    a = _angle(angle, "angle")
     w = np.mod(a + np.pi, 2 * np.pi) - np.pi
     return np.where(w == -np.pi, np.pi, w)
 
@@ -113,7 +144,7 @@ def wrap_angle(angle) -> np.ndarray:
 
 
 def _rot(angle, i: int, j: int, sign: float) -> np.ndarray:
-    a = np.asarray(angle, dtype=float)
+    a = _angle(angle, "angle")
     c, s = np.cos(a), np.sin(a)
     m = np.zeros(a.shape + (3, 3))
     k = 3 - i - j
@@ -150,7 +181,7 @@ def R3(angle) -> np.ndarray:
 
 def unit_vector(xi, psi) -> np.ndarray:
     r"""Benhamou's :math:`[\xi\bullet\psi] = (\cos\xi\cos\psi, \sin\xi\cos\psi, \sin\psi)`, shape (..., 3)."""
-    xi, psi = np.broadcast_arrays(np.asarray(xi, float), np.asarray(psi, float))
+    xi, psi = np.broadcast_arrays(_angle(xi, "xi"), _angle(psi, "psi"))
     return np.stack(
         [np.cos(xi) * np.cos(psi), np.sin(xi) * np.cos(psi), np.sin(psi)], axis=-1
     )
@@ -216,6 +247,8 @@ def angles_from_matrix(matrix, singular_tol: float = 1e-9) -> Orientation:
     C = np.asarray(matrix, dtype=float)
     if C.shape[-2:] != (3, 3):
         raise ValueError(f"matrix must have shape (..., 3, 3), got {C.shape}")
+    singular_tol = _v.nonnegative(singular_tol, "singular_tol")
+    _quat.check_rotation(C, "matrix")
     h = np.hypot(C[..., 0, 0], C[..., 1, 0])
     el = np.arctan2(C[..., 2, 0], h)
     az = np.arctan2(C[..., 1, 0], C[..., 0, 0])
@@ -234,7 +267,10 @@ def angles_to_quaternion(azimuth, elevation, bank) -> np.ndarray:
     Closed form :math:`q = q_z(\theta)\otimes q_y(-\phi)\otimes q_x(\lambda)`.
     """
     t, p, lam = np.broadcast_arrays(
-        *(np.asarray(a, float) / 2 for a in (azimuth, elevation, bank))
+        *(
+            _angle(a, n) / 2
+            for a, n in ((azimuth, "azimuth"), (elevation, "elevation"), (bank, "bank"))
+        )
     )
     ct, st = np.cos(t), np.sin(t)
     cp, sp = np.cos(p), -np.sin(p)  # rotation by -phi about y
@@ -252,6 +288,7 @@ def angles_from_quaternion(q, singular_tol: float = 1e-9) -> Orientation:
     q = np.asarray(q, dtype=float)
     if q.ndim == 0 or q.shape[-1] != 4:
         raise ValueError(f"q must have a last dimension of size 4, got {q.shape}")
+    _quat.check_unit(q, "q")
     return angles_from_matrix(_quat.to_matrix(q), singular_tol=singular_tol)
 
 
@@ -263,7 +300,9 @@ def acc_from_angles(
     Specific force (``"tiltlab"``): :math:`g\,C^\top e_z = g(\sin\phi, \cos\phi\sin\lambda, \cos\phi\cos\lambda)`;
     ``"benhamou"`` returns its negative.
     """
-    p, lam = np.broadcast_arrays(np.asarray(elevation, float), np.asarray(bank, float))
+    g = _v.positive(g, "g")
+    convention = _convention(convention)
+    p, lam = np.broadcast_arrays(_angle(elevation, "elevation"), _angle(bank, "bank"))
     f = g * np.stack(
         [np.sin(p), np.cos(p) * np.sin(lam), np.cos(p) * np.cos(lam)], axis=-1
     )
@@ -281,6 +320,9 @@ def geomagnetic_field(
     ``declination`` is positive East of true North:
     :math:`B(\cos I\sin D, \cos I\cos D, -\sin I)`.
     """
+    intensity = _v.positive(intensity, "intensity")
+    inclination = _v.finite(inclination, "inclination")
+    declination = _v.finite(declination, "declination")
     return intensity * np.array(
         [
             np.cos(inclination) * np.sin(declination),
@@ -311,7 +353,8 @@ def mounting_angles(
     with Benhamou's sign (converted from ``convention``). ``acc_rest`` may be a
     single vector or many (then average them first for a single mounting).
     """
-    return _elev_bank(_as_benhamou(acc_rest, convention, "acc_rest"))
+    a = _as_benhamou(acc_rest, convention, "acc_rest")
+    return _elev_bank(_nonzero(a, "acc_rest"))
 
 
 def _elev_bank(A):
@@ -400,9 +443,7 @@ def stage_angles(g) -> tuple[np.ndarray, np.ndarray]:
     :math:`g = R^\top e_z = (-\sin\beta, \sin\gamma\cos\beta, \cos\gamma\cos\beta)`,
     so :math:`\beta = -\arcsin g_x` and :math:`\gamma = \operatorname{atan2}(g_y, g_z)`.
     """
-    g = np.asarray(g, float)
-    if g.shape[-1] != 3:
-        raise ValueError(f"g must have last dimension 3, got {g.shape}")
+    g = _nonzero(_vec3(g, "g"), "g")
     g = g / np.linalg.norm(g, axis=-1, keepdims=True)
     # atan2 form of beta = -asin(g_x): accurate near the poles too
     return np.arctan2(-g[..., 0], np.hypot(g[..., 1], g[..., 2])), np.arctan2(
@@ -412,7 +453,7 @@ def stage_angles(g) -> tuple[np.ndarray, np.ndarray]:
 
 def stage_quaternion(pitch, roll) -> np.ndarray:
     """Orientation ``R_y(pitch) R_x(roll)`` (sensor → world) of the two-axis stage."""
-    pitch, roll = np.broadcast_arrays(np.asarray(pitch, float), np.asarray(roll, float))
+    pitch, roll = np.broadcast_arrays(_angle(pitch, "pitch"), _angle(roll, "roll"))
     z = np.zeros_like(pitch)
     return _quat.mul(
         _quat.from_rotvec(np.stack([z, pitch, z], -1)),
@@ -432,7 +473,17 @@ def head_frame_from_markers(m1, m2, m3) -> np.ndarray:
     :math:`h_y = (m_1 - m_2)/\|\cdot\|`, :math:`h_z = (m_3 - m_2) \times h_y / \|\cdot\|`,
     :math:`h_x = h_y \times h_z`.
     """
-    m1, m2, m3 = (np.asarray(v, float) for v in (m1, m2, m3))
+    m1, m2, m3 = (_vec3(v, n) for v, n in ((m1, "m1"), (m2, "m2"), (m3, "m3")))
+    v21, v23 = m1 - m2, m3 - m2
+    n21 = np.linalg.norm(v21, axis=-1)
+    ncz = np.linalg.norm(np.cross(v23, v21), axis=-1)
+    # frames with a missing (NaN) marker give NaN; NaN compares False here
+    bad = (n21 == 0) | (ncz <= 1e-9 * n21 * np.linalg.norm(v23, axis=-1))
+    if np.any(bad):
+        raise ValueError(
+            f"markers m1, m2, m3 are coincident or collinear in {int(bad.sum())} "
+            "frame(s): the head frame is undefined"
+        )
     hy = m1 - m2
     hy = hy / np.linalg.norm(hy, axis=-1, keepdims=True)
     hz = np.cross(m3 - m2, hy)

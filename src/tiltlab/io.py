@@ -26,6 +26,7 @@ import pandas as pd
 import xarray as xr
 
 from . import _validate, schema
+from . import quality as _quality
 from . import units as _units
 
 __all__ = [
@@ -152,8 +153,9 @@ def read_fayat_imu(
     df = _read_table(
         path, ["counter", "ax", "ay", "az", "gx", "gy", "gz"], final_newline=True
     )
+    counter_rate = _validate.positive(counter_rate, "counter_rate")
     counter = df["counter"].to_numpy(np.int64)
-    time = (counter - counter[0]) / float(counter_rate)
+    time = (counter - counter[0]) / counter_rate
     return schema.make_recording(
         df[["ax", "ay", "az"]].to_numpy(),
         df[["gx", "gy", "gz"]].to_numpy(),
@@ -185,6 +187,12 @@ def read_fayat_tumble(path: PathLike, *, fs: float = 300.0, **attrs) -> xr.Datas
     Columns: an unnamed index, ``ax, ay, az`` (g), ``gx, gy, gz`` (°/s), ``time`` (s);
     300 Hz. The sensor is held still in several orientations; there is no trigger
     channel.
+
+    The MPU9250 was set to ±4 g and ±1000 °/s: every value is a multiple of 1/8192 g and
+    1/32.768 °/s, and the file holds the rails −4 g, 32767/8192 g and −1000 °/s. Both are
+    recorded as the variables' ``range`` attribute (the full scale), so that the samples
+    clipped while the sensor was turned over are found
+    (:func:`tiltlab.quality.saturation`).
     """
     df = _read_table(
         path,
@@ -198,6 +206,8 @@ def read_fayat_tumble(path: PathLike, *, fs: float = 300.0, **attrs) -> xr.Datas
         fs,
         acc_units="g",
         gyr_units="deg/s",
+        acc_range=4.0,
+        gyr_range=1000.0,
         time=df["time"].to_numpy(),
         attrs={
             "source": str(Path(path).name),
@@ -345,6 +355,7 @@ _MAPPING_KEYS = (
     "time_scale",
     "time_units",
     "fs_range",
+    "range",
     "attrs",
     "read_csv",
 )
@@ -494,6 +505,27 @@ def _check_mapping(raw: Mapping[str, Any], where: str) -> dict[str, Any]:
         if lo >= hi:
             raise ValueError(f"{where}fs_range must be [low, high], got {fs_range!r}")
         fs_range = (lo, hi)
+    full: dict[str, Any] = {}
+    range_in = raw.get("range") or {}
+    if not isinstance(range_in, Mapping):
+        raise ValueError(
+            f"{where}'range' must map variables to their full scale, e.g. "
+            '{"acc": 16, "gyr": 2000}'
+        )
+    for var, value in range_in.items():
+        if var not in ("acc", "gyr", "mag"):
+            raise ValueError(
+                f"{where}range[{var!r}]: a full scale is given for acc, gyr or mag only"
+            )
+        if var not in cols:
+            raise ValueError(
+                f"{where}range[{var!r}] is given but {var!r} is not mapped"
+            )
+        try:
+            lo, hi = _quality.limits(value, f"{where}range[{var!r}]")
+        except ValueError as exc:
+            raise ValueError(str(exc)) from None
+        full[var] = hi if np.isclose(-lo, hi) else [lo, hi]
     attrs = raw.get("attrs") or {}
     if not isinstance(attrs, Mapping):
         raise ValueError(
@@ -518,6 +550,7 @@ def _check_mapping(raw: Mapping[str, Any], where: str) -> dict[str, Any]:
         "time_column": time_column,
         "time_scale": float(time_scale),
         "fs_range": fs_range,
+        "range": full,
         "attrs": dict(attrs),
         "read_csv": read_kwargs,
     }
@@ -545,8 +578,10 @@ def read_csv_mapping(mapping: Mapping[str, Any] | PathLike) -> dict[str, Any]:
         ``time_units`` (``"s"``, ``"ms"``, ``"us"``; also accepted as
         ``units["time"]``) or ``time_scale`` (factor to seconds) give the unit of the
         time column (default seconds); ``fs_range`` ([low, high] Hz, ``null`` to
-        disable) bounds a plausible sampling rate; ``attrs`` are extra Recording
-        attributes; any other key is a :func:`pandas.read_csv` option (``sep``,
+        disable) bounds a plausible sampling rate; ``range`` (variable → full scale in
+        its units, ``r`` for ±r or ``[low, high]``, for ``acc``, ``gyr``, ``mag``) is the
+        sensor's measurement range, used to find clipped samples; ``attrs`` are extra
+        Recording attributes; any other key is a :func:`pandas.read_csv` option (``sep``,
         ``decimal``, ``skiprows``, ``comment``, ``encoding``…), or put them under
         ``read_csv``.
 
@@ -555,7 +590,7 @@ def read_csv_mapping(mapping: Mapping[str, Any] | PathLike) -> dict[str, Any]:
     dict
         Keys ``columns`` (variable → list of names), ``units`` (canonical spellings),
         ``fs`` (float or None), ``time_column``, ``time_scale`` (factor to seconds),
-        ``fs_range``, ``attrs`` and ``read_csv`` (options for :func:`pandas.read_csv`).
+        ``fs_range``, ``range`` (variable → full scale), ``attrs`` and ``read_csv`` (options for :func:`pandas.read_csv`).
 
     Raises
     ------
@@ -583,13 +618,24 @@ def _check_time(time: np.ndarray, column: str, path: Path) -> None:
         )
 
 
-def _unit_hint(raw_step: float, fs_range: tuple[float, float] | None) -> str:
-    """Which time unit would make the median step a plausible sampling interval."""
+_TIME_NAMES = {"s": "seconds", "ms": "milliseconds", "us": "microseconds"}
+
+
+def _unit_hint(
+    raw_step: float, fs_range: tuple[float, float] | None, scale: float | None = None
+) -> str:
+    """Which time unit (other than the one in use, factor ``scale`` to seconds) would
+    make the median step a plausible sampling interval."""
     lo, hi = fs_range or FS_RANGE
     for unit, factor in TIME_UNITS.items():
+        if scale is not None and np.isclose(factor, scale):
+            continue
         f = 1.0 / (raw_step * factor)
         if lo <= f <= hi:
-            return f"; is the time column in {unit}? give time_units={unit!r} (fs would be {f:.6g} Hz)"
+            return (
+                f"; the time column looks like {_TIME_NAMES[unit]}: give "
+                f"time_units={unit!r} (fs would be {f:.6g} Hz)"
+            )
     return ""
 
 
@@ -624,7 +670,8 @@ def read_csv(
     mapping : dict or path-like, optional
         A whole mapping (``columns``, ``units``, ``fs``, ``time_column``, ``time_units``
         …, see :func:`read_csv_mapping`), or the path of a JSON file holding one.
-        Arguments given explicitly override it (``units`` and ``attrs`` are merged).
+        Arguments given explicitly override it (``units`` and ``attrs`` are merged); its
+        ``range`` (variable → the sensor's full scale) may also be given as a keyword.
     fs : float, optional
         Sampling rate (Hz). If omitted, ``time_column`` is required and ``fs`` is
         estimated as 1 / median interval, to 7 significant digits (recorded in
@@ -689,6 +736,8 @@ def read_csv(
         raw["fs_range"] = fs_range
     if attrs:
         raw["attrs"] = {**(raw.get("attrs") or {}), **attrs}
+    if "range" in read_kwargs:  # the sensor's full scale, as in a mapping
+        raw["range"] = read_kwargs.pop("range")
     nested = read_kwargs.pop("read_csv", None) or {}
     if not isinstance(nested, Mapping):
         raise ValueError("read_csv must be a mapping of pandas.read_csv options")
@@ -719,7 +768,10 @@ def read_csv(
                 raise ValueError(
                     f"{path}: sampling rate estimated from time column {tcol!r} ({unit}) is "
                     f"{fs_est:.6g} Hz, outside the plausible range {lo_hi[0]:g}–{lo_hi[1]:g} Hz"
-                    + (_unit_hint(raw_step, lo_hi) or "; give fs, or widen fs_range")
+                    + (
+                        _unit_hint(raw_step, lo_hi, m["time_scale"])
+                        or "; give fs, or widen fs_range"
+                    )
                 )
             # 7 significant digits: the median of parsed intervals carries rounding noise
             fs = float(f"{fs_est:.7g}")
@@ -728,7 +780,7 @@ def read_csv(
             raise ValueError(
                 f"{path}: fs = {fs:g} Hz but time column {tcol!r} ({unit}) gives "
                 f"{fs_est:.6g} Hz (median interval {raw_step:g} {unit})"
-                + _unit_hint(raw_step, (0.98 * fs, 1.02 * fs))
+                + _unit_hint(raw_step, (0.98 * fs, 1.02 * fs), m["time_scale"])
             )
     if lo_hi is not None and not lo_hi[0] <= fs <= lo_hi[1]:
         raise ValueError(
@@ -743,6 +795,9 @@ def read_csv(
         gyr_units=m["units"]["gyr"],
         mag=get.get("mag"),
         mag_units=m["units"].get("mag", "uT"),
+        acc_range=m["range"].get("acc"),
+        gyr_range=m["range"].get("gyr"),
+        mag_range=m["range"].get("mag"),
         temp=get["temp"][:, 0] if "temp" in get else None,
         temp_units=m["units"].get("temp", "degC"),
         q_ref=get.get("q_ref"),
@@ -776,6 +831,10 @@ def save_netcdf(ds: xr.Dataset, path: PathLike) -> Path:
     NetCDF attributes cannot hold booleans, dicts or None, so every attribute (of the
     dataset, its variables and coordinates) is also stored as JSON and restored on load.
     """
+    if not isinstance(ds, xr.Dataset):
+        raise TypeError(
+            f"save_netcdf writes a Recording (xarray.Dataset), got {type(ds).__name__}"
+        )
     path = Path(path)
     out = ds.copy()
     record = {"__dataset__": dict(ds.attrs)}

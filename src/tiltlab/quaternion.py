@@ -15,6 +15,13 @@ quaternions, ``(..., 3)`` for vectors, ``(..., 3, 3)`` for matrices), broadcasts
 its arguments, never modifies its inputs and returns new arrays. The loops run in
 ``@njit(cache=True)`` kernels.
 
+Inputs are checked before the kernels run (:class:`ValueError` naming the argument):
+NaN marks a missing sample and propagates, but an infinite value, a zero quaternion or
+vector (no rotation, no direction), a non-unit quaternion where a rotation matrix or
+angle is derived from it (:func:`to_matrix`, :func:`to_rotvec`, tolerance 1e-6) and a
+matrix that is not a rotation (:func:`from_matrix`: orthonormal within 1e-6, det +1)
+are errors, never silently wrong or NaN output.
+
 References
 ----------
 .. [1] J. Solà, "Quaternion kinematics for the error-state Kalman filter",
@@ -29,6 +36,8 @@ from __future__ import annotations
 
 import numpy as np
 from numba import njit
+
+from . import _validate as _v
 
 __all__ = [
     "identity",
@@ -293,10 +302,76 @@ def _check_last(a: np.ndarray, width: int, name: str) -> None:
         )
 
 
+def _broadcast(*named) -> list[np.ndarray]:
+    """``np.broadcast_arrays`` of ``(name, array)`` pairs; a mismatch names them."""
+    try:
+        return np.broadcast_arrays(*(a for _, a in named))
+    except ValueError:
+        shapes = " and ".join(f"{n} {a.shape}" for n, a in named)
+        raise ValueError(
+            f"{' and '.join(n for n, _ in named)} have incompatible shapes: {shapes}"
+        ) from None
+
+
+def _no_inf(a: np.ndarray, name: str) -> np.ndarray:
+    """``a`` unchanged; infinite values raise (NaN, a missing sample, passes)."""
+    if np.any(np.isinf(a)):
+        raise ValueError(f"{name} has {int(np.sum(np.isinf(a)))} infinite values")
+    return a
+
+
+def _no_zero(q: np.ndarray, name: str) -> np.ndarray:
+    """``q`` unchanged; a zero quaternion, which is no rotation, raises."""
+    if np.any(np.sum(q * q, axis=-1) == 0):
+        raise ValueError(f"{name} has zero quaternions, which are not rotations")
+    return q
+
+
+def check_unit(q: np.ndarray, name: str = "q", atol: float = 1e-6) -> None:
+    """Raise unless every finite quaternion of ``q`` (…, 4) has norm 1 within ``atol``.
+
+    NaN quaternions (missing samples) pass; infinities do not.
+    """
+    if np.any(np.isinf(q)):
+        raise ValueError(f"{name} has infinite values")
+    n = np.linalg.norm(q, axis=-1)
+    bad = np.abs(n - 1.0) > atol  # NaN compares False
+    if np.any(bad):
+        k = int(np.argmax(bad.ravel()))
+        raise ValueError(
+            f"{name} must hold unit quaternions: {int(bad.sum())} have a norm other than "
+            f"1 (first: {float(n.ravel()[k]):.6g}); normalise them first "
+            "(a zero quaternion is not a rotation)"
+        )
+
+
+def check_rotation(m: np.ndarray, name: str = "m", atol: float = 1e-6) -> None:
+    """Raise unless every finite (3, 3) matrix of ``m`` is a proper rotation
+    (orthonormal within ``atol``, determinant +1). NaN matrices pass; infinities do not."""
+    if np.any(np.isinf(m)):
+        raise ValueError(f"{name} has infinite values")
+    M = m[np.all(np.isfinite(m), axis=(-2, -1))]
+    if M.size == 0:
+        return
+    err = np.abs(np.swapaxes(M, -1, -2) @ M - np.eye(3)).max(axis=(-2, -1))
+    if np.any(err > atol):
+        raise ValueError(
+            f"{name} must hold rotation matrices (orthonormal, det +1): "
+            f"max |MᵀM − I| = {float(err.max()):.3g}"
+        )
+    det = np.linalg.det(M)
+    if np.any(det < 0):
+        raise ValueError(
+            f"{name} must hold rotation matrices (det +1), got {int(np.sum(det < 0))} "
+            "reflection(s) (det −1)"
+        )
+
+
 def identity(n: int | None = None) -> np.ndarray:
     """The identity quaternion (1, 0, 0, 0), or ``n`` of them."""
     if n is None:
         return np.array([1.0, 0.0, 0.0, 0.0])
+    n = _v.integer(n, "n", minimum=0)
     out = np.zeros((n, 4))
     out[:, 0] = 1.0
     return out
@@ -310,7 +385,7 @@ def mul(p, q) -> np.ndarray:
     p, q = np.asarray(p, float), np.asarray(q, float)
     _check_last(p, 4, "p")
     _check_last(q, 4, "q")
-    p, q = np.broadcast_arrays(p, q)
+    p, q = _broadcast(("p", _no_inf(p, "p")), ("q", _no_inf(q, "q")))
     shape = p.shape
     out = np.empty((int(np.prod(shape[:-1], dtype=np.int64)), 4))
     _mul_kernel(_as2d(p, 4), _as2d(q, 4), out)
@@ -328,6 +403,8 @@ def conj(q) -> np.ndarray:
 def inv(q) -> np.ndarray:
     """Inverse :math:`q^* / \\|q\\|^2` (equals :func:`conj` for unit quaternions)."""
     q = np.asarray(q, float)
+    _check_last(q, 4, "q")
+    _no_zero(_no_inf(q, "q"), "q")
     return conj(q) / np.sum(q * q, axis=-1, keepdims=True)
 
 
@@ -338,11 +415,13 @@ def norm(q) -> np.ndarray:
 
 def normalize(q) -> np.ndarray:
     """Unit quaternions; a zero quaternion is an error."""
-    q = np.asarray(q, float)
+    q = _no_inf(np.asarray(q, float), "q")
     _check_last(q, 4, "q")
     n = np.linalg.norm(q, axis=-1, keepdims=True)
     if np.any(n == 0):
-        raise ValueError("cannot normalise a zero quaternion")
+        raise ValueError(
+            f"q has {int(np.sum(n == 0))} zero quaternion(s), which cannot be normalised"
+        )
     return q / n
 
 
@@ -366,7 +445,9 @@ def _rotate(q, v, inverse: bool) -> np.ndarray:
     q, v = np.asarray(q, float), np.asarray(v, float)
     _check_last(q, 4, "q")
     _check_last(v, 3, "v")
-    lead = np.broadcast_shapes(q.shape[:-1], v.shape[:-1])
+    _no_zero(_no_inf(q, "q"), "q")
+    _no_inf(v, "v")
+    lead = _broadcast(("q", q[..., 0]), ("v", v[..., 0]))[0].shape
     qb = np.broadcast_to(q, lead + (4,))
     vb = np.broadcast_to(v, lead + (3,))
     out = np.empty((int(np.prod(lead, dtype=np.int64)), 3))
@@ -378,6 +459,7 @@ def to_matrix(q) -> np.ndarray:
     """Rotation matrices R(q), shape (..., 3, 3), mapping sensor to world coordinates."""
     q = np.asarray(q, float)
     _check_last(q, 4, "q")
+    check_unit(q, "q")
     out = np.empty((int(np.prod(q.shape[:-1], dtype=np.int64)), 3, 3))
     _to_matrix_kernel(_as2d(q, 4), out)
     return out.reshape(q.shape[:-1] + (3, 3))
@@ -388,6 +470,7 @@ def from_matrix(m) -> np.ndarray:
     m = np.asarray(m, float)
     if m.shape[-2:] != (3, 3):
         raise ValueError(f"m must have shape (..., 3, 3), got {m.shape}")
+    check_rotation(m, "m")
     out = np.empty((int(np.prod(m.shape[:-2], dtype=np.int64)), 4))
     _from_matrix_kernel(np.ascontiguousarray(m.reshape(-1, 3, 3)), out)
     return out.reshape(m.shape[:-2] + (4,))
@@ -397,6 +480,7 @@ def to_rotvec(q) -> np.ndarray:
     """Rotation vectors (axis × angle, angle in [0, π]) of unit quaternions."""
     q = np.asarray(q, float)
     _check_last(q, 4, "q")
+    check_unit(q, "q")
     out = np.empty((int(np.prod(q.shape[:-1], dtype=np.int64)), 3))
     _to_rotvec_kernel(_as2d(q, 4), out)
     return out.reshape(q.shape[:-1] + (3,))
@@ -404,8 +488,14 @@ def to_rotvec(q) -> np.ndarray:
 
 def from_rotvec(r) -> np.ndarray:
     r"""Unit quaternions :math:`(\cos\tfrac{\theta}{2}, \sin\tfrac{\theta}{2}\,\hat r)` from rotation vectors."""
-    r = np.asarray(r, float)
+    r = _no_inf(np.asarray(r, float), "r")
     _check_last(r, 3, "r")
+    with np.errstate(over="ignore"):
+        big = np.isinf(np.linalg.norm(r, axis=-1))
+    if np.any(big):
+        raise ValueError(
+            f"r has {int(big.sum())} rotation vectors too large to represent"
+        )
     out = np.empty((int(np.prod(r.shape[:-1], dtype=np.int64)), 4))
     _from_rotvec_kernel(_as2d(r, 3), out)
     return out.reshape(r.shape[:-1] + (4,))
@@ -432,6 +522,7 @@ def gravity(q) -> np.ndarray:
     """
     q = np.asarray(q, float)
     _check_last(q, 4, "q")
+    _no_zero(_no_inf(q, "q"), "q")
     out = np.empty((int(np.prod(q.shape[:-1], dtype=np.int64)), 3))
     _gravity_kernel(_as2d(q, 4), out)
     return out.reshape(q.shape[:-1] + (3,))
@@ -442,7 +533,11 @@ def angle_between(u, v) -> np.ndarray:
     u, v = np.asarray(u, float), np.asarray(v, float)
     _check_last(u, 3, "u")
     _check_last(v, 3, "v")
-    lead = np.broadcast_shapes(u.shape[:-1], v.shape[:-1])
+    for name, a in (("u", u), ("v", v)):
+        _no_inf(a, name)
+        if np.any(np.sum(a * a, axis=-1) == 0):
+            raise ValueError(f"{name} has zero vectors: their direction is undefined")
+    lead = _broadcast(("u", u[..., 0]), ("v", v[..., 0]))[0].shape
     out = np.empty(int(np.prod(lead, dtype=np.int64)))
     _angle_between_kernel(
         _as2d(np.broadcast_to(u, lead + (3,)), 3),
@@ -465,7 +560,9 @@ def error_angles(q_est, q_ref) -> np.ndarray:
     p, q = np.asarray(q_est, float), np.asarray(q_ref, float)
     _check_last(p, 4, "q_est")
     _check_last(q, 4, "q_ref")
-    p, q = np.broadcast_arrays(p, q)
+    _no_zero(_no_inf(p, "q_est"), "q_est")
+    _no_zero(_no_inf(q, "q_ref"), "q_ref")
+    p, q = _broadcast(("q_est", p), ("q_ref", q))
     out = np.empty((int(np.prod(p.shape[:-1], dtype=np.int64)), 3))
     _error_angles_kernel(_as2d(p, 4), _as2d(q, 4), out)
     return out.reshape(p.shape[:-1] + (3,))
@@ -513,13 +610,21 @@ def integrate_gyro(omega, fs: float, q0=None) -> np.ndarray:
     numpy.ndarray, shape (N, 4)
         ``q[0] = q0``; ``q[k]`` is the orientation after ``k`` steps.
     """
-    if fs is None or not np.isfinite(fs) or fs <= 0:
-        raise ValueError(f"fs must be a positive number of Hz, got {fs!r}")
-    omega = np.ascontiguousarray(omega, dtype=float)
-    _check_last(omega, 3, "omega")
-    if omega.ndim != 2:
-        raise ValueError(f"omega must have shape (N, 3), got {omega.shape}")
-    q0 = identity() if q0 is None else normalize(np.asarray(q0, float))
+    fs = _v.check_fs(fs)
+    omega = np.ascontiguousarray(_v.vectors(omega, "omega", width=3, ndim=2))
+    with np.errstate(over="ignore"):
+        big = ~np.isfinite(np.linalg.norm(omega, axis=1))
+    if np.any(big):
+        raise ValueError(
+            f"omega has {int(big.sum())} angular velocities too large to represent"
+        )
+    if q0 is None:
+        q0 = identity()
+    else:
+        q0 = _v.vectors(q0, "q0", width=4, ndim=1)
+        if not np.linalg.norm(q0) > 0:
+            raise ValueError(f"q0 must be a non-zero quaternion (w, x, y, z), got {q0}")
+        q0 = q0 / np.linalg.norm(q0)
     out = np.empty((omega.shape[0], 4))
     if omega.shape[0]:
         _integrate_kernel(omega, 1.0 / fs, q0, out)
@@ -545,6 +650,7 @@ def random_quaternions(
     n: int, rng: np.random.Generator | int | None = None
 ) -> np.ndarray:
     """``n`` uniformly distributed unit quaternions (Shoemake's method), w ≥ 0."""
+    n = _v.integer(n, "n", minimum=0)
     rng = np.random.default_rng(rng)
     u1, u2, u3 = rng.random((3, n))
     a, b = np.sqrt(1.0 - u1), np.sqrt(u1)

@@ -12,10 +12,15 @@ A Recording is an :class:`xarray.Dataset` with
 * mandatory dataset attribute ``fs`` (Hz), ``frame`` (the frame the vectors are
   expressed in, normally ``"sensor"``), and provenance attributes (``source``,
   ``sensor``, ``subject``, ``session``);
-* a ``units`` attribute on every physical variable.
+* a ``units`` attribute on every physical variable, and optionally a ``range``
+  attribute on ``acc``, ``gyr``, ``mag``: the sensor's full scale in those units
+  (``r`` for ±r, or ``[low, high]``), from which clipped samples are found.
 
 :func:`make_recording` builds one from arrays and :func:`validate` checks one,
-raising :class:`RecordingError` with a message naming the problem.
+raising :class:`RecordingError` with a message naming the problem. :func:`validate`
+also checks that the values are plausible for their units and looks for clipped
+samples (:mod:`tiltlab.quality`): hard problems raise, soft ones warn
+(:class:`tiltlab.quality.QualityWarning`).
 """
 
 from __future__ import annotations
@@ -26,8 +31,13 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
+from . import quality as _quality
 from . import units as _units
 from ._validate import RecordingError
+from ._validate import check_fs as _check_fs
+from ._validate import finite as _finite
+from ._validate import nonnegative as _nonnegative
+from ._validate import positive as _positive
 
 __all__ = [
     "AXES",
@@ -61,6 +71,9 @@ def make_recording(
     gyr_units: str = "deg/s",
     mag=None,
     mag_units: str = "uT",
+    acc_range=None,
+    gyr_range=None,
+    mag_range=None,
     temp=None,
     temp_units: str = "degC",
     q_ref=None,
@@ -82,6 +95,10 @@ def make_recording(
         Sampling rate in Hz. Mandatory: tiltlab never assumes a default.
     mag : array_like, shape (N, 3), optional
         Magnetometer samples in ``mag_units``.
+    acc_range, gyr_range, mag_range : float or (float, float), optional
+        The sensor's full scale (measurement range) in the variable's units, ``r`` for
+        ±r or ``(low, high)``, stored as the variable's ``range`` attribute; used to find
+        clipped samples (:func:`tiltlab.quality.saturation`). Unknown by default.
     temp : array_like, shape (N,), optional
         Sensor temperature in ``temp_units``.
     q_ref : array_like, shape (N, 4), optional
@@ -92,7 +109,8 @@ def make_recording(
         Frame in which the vectors are expressed (default ``"sensor"``).
     extra : mapping, optional
         Additional per-sample variables, ``name -> array`` (first dim = time) or
-        ``name -> (dims, array, attrs)``.
+        ``name -> (dims, array, attrs)``. Copied: the Recording never shares memory with
+        the caller's arrays.
     attrs : mapping, optional
         Dataset attributes (provenance: ``source``, ``sensor``, ``subject``, ``session`` …).
     validate_result : bool
@@ -109,9 +127,10 @@ def make_recording(
         raise RecordingError(
             "fs (sampling rate, Hz) is mandatory; tiltlab never assumes a default"
         )
-    fs = float(fs)
-    if not np.isfinite(fs) or fs <= 0:
-        raise RecordingError(f"fs must be a positive finite number of Hz, got {fs!r}")
+    try:
+        fs = _check_fs(fs)
+    except ValueError as err:
+        raise RecordingError(str(err)) from None
     acc = np.asarray(acc, dtype=float)
     gyr = np.asarray(gyr, dtype=float)
     if acc.ndim != 2 or acc.shape[1] != 3:
@@ -125,7 +144,7 @@ def make_recording(
     n = acc.shape[0]
     if time is None:
         time = t0 + np.arange(n) / fs
-    time = np.asarray(time, dtype=float)
+    time = np.array(time, dtype=float)  # a copy: never alias the caller's array
     if time.shape != (n,):
         raise RecordingError(f"time must have shape ({n},), got {time.shape}")
 
@@ -172,9 +191,21 @@ def make_recording(
                 "frame": "sensor->world",
             },
         )
+    for name, full in (("acc", acc_range), ("gyr", gyr_range), ("mag", mag_range)):
+        if full is not None and name in data_vars:
+            lo, hi = _quality.limits(full, f"{name}_range", RecordingError)
+            data_vars[name][2]["range"] = hi if np.isclose(-lo, hi) else [lo, hi]
     for name, value in (extra or {}).items():
         if isinstance(value, tuple):
-            data_vars[name] = value
+            if len(value) < 2:
+                raise RecordingError(
+                    f"extra variable {name!r}: give (dims, array) or (dims, array, attrs)"
+                )
+            data_vars[name] = (
+                value[0],
+                np.array(value[1]),  # a copy, as for every other variable
+                *(dict(a) if isinstance(a, Mapping) else a for a in value[2:]),
+            )
         else:
             arr = np.array(value)
             dims = (
@@ -252,8 +283,10 @@ def validate(
     max_jitter: float = 0.35,
     quat_atol: float = 1e-6,
     check_units: bool = True,
+    check_saturation: bool = True,
 ) -> xr.Dataset:
-    """Check that ``ds`` satisfies the Recording contract.
+    """Check that ``ds`` satisfies the Recording contract, and that its values are
+    plausible for their units.
 
     Parameters
     ----------
@@ -268,7 +301,15 @@ def validate(
     quat_atol : float
         Tolerance on ``| ‖q‖ − 1 |`` for ``q_ref``.
     check_units : bool
-        Run the gyroscope unit plausibility check (:func:`tiltlab.units.check_gyro_units`).
+        Run the plausibility checks of the values against their units
+        (:func:`tiltlab.quality.plausibility`: accelerometer magnitude, raw ADC counts,
+        gyroscope magnitude, temperature) and the gyroscope unit check
+        (:func:`tiltlab.units.check_gyro_units`). Their hard findings (e.g. ``acc``
+        labelled g with a median magnitude of 9.8) raise, the soft ones warn.
+    check_saturation : bool
+        Warn (:class:`tiltlab.quality.QualityWarning`) about clipped samples of ``acc``,
+        ``gyr`` and ``mag``, with the fraction clipped per variable
+        (:func:`tiltlab.quality.check_saturation`).
 
     Returns
     -------
@@ -278,12 +319,19 @@ def validate(
     Raises
     ------
     RecordingError
-        With a message naming the first problem found.
+        With a message naming the first problem found (all hard plausibility problems).
+
+    Warns
+    -----
+    tiltlab.quality.QualityWarning
+        One per soft problem: clipped samples, a doubtful magnitude or temperature.
     """
     if not isinstance(ds, xr.Dataset):
         raise RecordingError(
             f"a Recording is an xarray.Dataset, got {type(ds).__name__}"
         )
+    max_jitter = _positive(max_jitter, "max_jitter", allow_zero=True, allow_inf=True)
+    quat_atol = _nonnegative(_finite(quat_atol, "quat_atol"), "quat_atol")
     fs = ds.attrs.get("fs")
     if fs is None:
         raise RecordingError(
@@ -339,6 +387,7 @@ def validate(
         if name in ds:
             _check_vector_var(ds, name, allow_nan)
             _check_units(ds[name], name)
+            _quality.full_scale(ds[name], repr(name))  # a malformed 'range' is an error
     if "temp" in ds:
         if ds["temp"].dims != ("time",):
             raise RecordingError(
@@ -371,6 +420,14 @@ def validate(
                 f"variable {name!r}: 'time' must be the first dimension, got {da.dims}"
             )
 
+    findings = _quality.plausibility(ds) if check_units else []
+    if any(f.is_error for f in findings):
+        try:
+            _quality.emit(findings)
+        except RecordingError as exc:
+            raise RecordingError(
+                f"{exc} (validate(..., check_units=False) skips this check)"
+            ) from None
     if check_units:
         acc = np.asarray(ds["acc"].values, dtype=float)
         gyr = np.asarray(ds["gyr"].values, dtype=float)
@@ -381,15 +438,20 @@ def validate(
             _units.check_gyro_units(gyr, ds["gyr"].attrs["units"], acc, fs)
         except _units.UnitsError as exc:
             raise RecordingError(str(exc)) from None
+    if check_saturation:
+        findings += _quality.check_saturation(ds)
+    _quality.emit(findings)
     return ds
 
 
 def to_units(ds: xr.Dataset, **targets: str) -> xr.Dataset:
     """Return a copy of ``ds`` with variables converted, e.g. ``to_units(rec, acc='m/s^2', gyr='rad/s')``.
 
-    Attributes are kept and each converted variable's ``units`` attribute is updated.
+    Attributes are kept and each converted variable's ``units`` attribute is updated, and
+    its ``range`` (full scale) converted. The copy is deep: it shares no memory with
+    ``ds``.
     """
-    out = ds.copy()
+    out = ds.copy(deep=True)
     for name, dst in targets.items():
         if name not in ds:
             raise RecordingError(f"variable {name!r} is not in the Recording")
@@ -398,7 +460,12 @@ def to_units(ds: xr.Dataset, **targets: str) -> xr.Dataset:
             raise RecordingError(f"{name!r} has no 'units' attribute")
         f = _units.conversion_factor(src, dst)
         out[name] = ds[name] * f
-        out[name].attrs = {**ds[name].attrs, "units": _units.normalise_unit(dst)}
+        attrs = {**ds[name].attrs, "units": _units.normalise_unit(dst)}
+        full = _quality.full_scale(ds[name], repr(name))
+        if full is not None:
+            lo, hi = full[0] * f, full[1] * f
+            attrs["range"] = hi if np.isclose(-lo, hi) else [lo, hi]
+        out[name].attrs = attrs
     return out
 
 

@@ -1,6 +1,10 @@
 """Physical units used by tiltlab Recordings, conversions between them, and a
 plausibility check that catches a gyroscope whose units are mislabelled.
 
+The magnitude checks of values against their unit labels (accelerometer ~1 g, raw ADC
+counts, gyroscope ranges, temperature) and sensor saturation live in
+:mod:`tiltlab.quality`; :func:`tiltlab.schema.validate` runs both.
+
 Units travel as strings in the ``units`` attribute of each variable. Only the
 spellings listed in :data:`UNITS` are accepted; aliases are normalised by
 :func:`normalise_unit`.
@@ -188,7 +192,9 @@ def check_gyro_units(
     """
     gyr = np.asarray(gyr, dtype=float)
     acc = np.asarray(acc, dtype=float)
-    if gyr.shape[0] < 10:
+    fs = check_fs(fs)
+    # too short to judge, also when the ~50 ms smoothing window spans the recording
+    if gyr.shape[0] < 10 or 0.05 * fs >= gyr.shape[0] / 2:
         return None
     # smooth the acceleration direction over ~50 ms to suppress noise and vibration
     w = max(1, int(round(0.05 * fs)))

@@ -23,6 +23,12 @@ __all__ = ["azimuthal_speed", "circling_index"]
 def _read_pair(gyr, g, units):
     sw = read(gyr, "gyr", units=units, to_units="deg/s", allow_nan=True)
     sg = read(g, "g", var="gravity", allow_nan=True)
+    zero = np.sum(sg.values * sg.values, axis=1) == 0  # NaN rows (gaps) pass
+    if np.any(zero):
+        raise ValueError(
+            f"g has {int(zero.sum())} zero vectors: the gravity direction is undefined "
+            "there (use NaN for missing samples)"
+        )
     if sw.values.shape != sg.values.shape:
         raise ValueError(
             "gyr and g must both have shape (N, 3) with the same N, got "

@@ -244,6 +244,8 @@ def identifiable_matrix(matrix) -> np.ndarray:
     triangular :math:`C` with the truth through ``identifiable_matrix(C_true)``.
     """
     C = mat3(matrix, "matrix")
+    if np.linalg.matrix_rank(C) < 3:
+        raise ValueError("matrix is singular: a correction matrix must be invertible")
     _, R = np.linalg.qr(C)
     return np.diag(np.sign(np.diag(R))) @ R
 
@@ -535,7 +537,10 @@ def lattice_subset(directions, k: int) -> np.ndarray:
 def triplet_orthogonality(directions) -> np.ndarray:
     r"""|det[u_1 u_2 u_3]| of unit directions (…, 3, 3): 1 for mutually orthogonal, 0 for coplanar."""
     d = vec3(directions, "directions")
-    u = d / np.linalg.norm(d, axis=-1, keepdims=True)
+    nd = np.linalg.norm(d, axis=-1, keepdims=True)
+    if np.any(nd == 0):
+        raise ValueError("directions has zero vectors: their direction is undefined")
+    u = d / nd
     return np.abs(np.linalg.det(u))
 
 

@@ -43,12 +43,23 @@ __all__ = [
 _UNITS = {"acc": "g", "gyr": "deg/s", "mag": "uT"}
 
 
-def _tup(v, shape):
+def _tup(v, shape, name: str):
     if v is None:
         return None
-    a = np.asarray(v, dtype=float)
-    if a.shape != shape or not np.all(np.isfinite(a)):
-        raise ValueError(f"expected a finite array of shape {shape}, got {a.shape}")
+    try:
+        a = np.asarray(v, dtype=float)
+    except (TypeError, ValueError):
+        raise ValueError(
+            f"Calibration.{name} must be numbers of shape {shape}, got {v!r}"
+        ) from None
+    if a.shape != shape:
+        raise ValueError(
+            f"Calibration.{name} must have shape {shape}, got shape {a.shape}"
+        )
+    if not np.all(np.isfinite(a)):
+        raise ValueError(
+            f"Calibration.{name} has {int(np.sum(~np.isfinite(a)))} non-finite values"
+        )
     return tuple(map(tuple, a)) if a.ndim == 2 else tuple(a.tolist())
 
 
@@ -87,10 +98,14 @@ class Calibration:
     def __post_init__(self):
         for s in ("acc", "gyr", "mag"):
             object.__setattr__(
-                self, f"{s}_offset", _tup(getattr(self, f"{s}_offset"), (3,))
+                self,
+                f"{s}_offset",
+                _tup(getattr(self, f"{s}_offset"), (3,), f"{s}_offset"),
             )
             object.__setattr__(
-                self, f"{s}_matrix", _tup(getattr(self, f"{s}_matrix"), (3, 3))
+                self,
+                f"{s}_matrix",
+                _tup(getattr(self, f"{s}_matrix"), (3, 3), f"{s}_matrix"),
             )
         for s in ("acc", "gyr"):
             tm = getattr(self, f"{s}_temp")
@@ -103,7 +118,7 @@ class Calibration:
                     )
                 if _units.normalise_unit(tm.units) != _UNITS[s]:
                     raise ValueError(f"{s}_temp must be in {_UNITS[s]}, got {tm.units}")
-        object.__setattr__(self, "rotation", _tup(self.rotation, (3, 3)))
+        object.__setattr__(self, "rotation", _tup(self.rotation, (3, 3), "rotation"))
         if self.rotation is not None:
             R = np.asarray(self.rotation)
             if not np.allclose(R @ R.T, np.eye(3), atol=1e-6) or np.linalg.det(R) < 0:

@@ -300,8 +300,14 @@ def allan_noise_parameters(taus_s, adev) -> AllanNoise:
     """
     t = _v.vectors(taus_s, "taus_s", width=None, ndim=1)
     if np.any(t <= 0):
-        raise ValueError("taus_s must be positive durations (s)")
+        raise ValueError(
+            f"taus_s must be positive durations (s), got {t[t <= 0].tolist()[:5]}"
+        )
     a = _v.vectors(adev, "adev", width=None, ndim=None)
+    if np.any(a < 0):
+        raise ValueError(
+            f"adev must hold Allan deviations (>= 0), got {int(np.sum(a < 0))} negative values"
+        )
     if a.shape[0] != t.size:
         raise ValueError(
             f"adev must have one row per tau ({t.size}), got shape {a.shape}"

@@ -201,7 +201,12 @@ def apply_mag_calibration(mag, offset, matrix=None):
     s = _v.signal(mag, "mag", need_fs=False, ndim=None, allow_nan=True)
     d = s.values - vec3(offset, "offset", ndim=1)
     if matrix is not None:
-        d = d @ mat3(matrix, "matrix").T
+        S = mat3(matrix, "matrix")
+        if np.linalg.matrix_rank(S) < 3:
+            raise ValueError(
+                "matrix is singular: a soft-iron / scale correction must be invertible"
+            )
+        d = d @ S.T
     da = mag["mag"] if isinstance(mag, xr.Dataset) else mag
     dims = tuple(da.dims) if isinstance(da, xr.DataArray) else None
     units = s.units if matrix is None else None

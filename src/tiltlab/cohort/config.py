@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import re
 from dataclasses import dataclass, field, fields
 from typing import Any
 
@@ -37,6 +38,32 @@ def _plain(v):
     if isinstance(v, dict):
         return {str(k): _plain(x) for k, x in v.items()}
     return v
+
+
+#: sampling rate (Hz) of the synthetic input of :func:`_dry_run`: high, so that limits
+#: that scale with fs (a cut-off below Nyquist) do not refuse values valid on real data
+_DRY_FS = 1e5
+
+
+def _dry_run(method, params: dict, use_mag: bool) -> None:
+    """Run ``method`` on a short synthetic static input, so that an out-of-domain
+    parameter (a negative cut-off, a NaN gain) is refused when the configuration is
+    built, not once per session. Only errors naming a parameter count (the synthetic
+    input is valid); the adapters to other packages are not run."""
+    if method.kind == "adapter":
+        return
+    n = 32
+    acc = np.tile([0.0, 0.0, 9.80665], (n, 1))
+    gyr = np.zeros((n, 3))
+    mag = np.tile([0.0, 20.0, -40.0], (n, 1)) if use_mag else None
+    try:
+        method(acc, gyr, _DRY_FS, mag, **params)
+    except ValueError as exc:
+        msg = str(exc)
+        if any(re.search(rf"\b{re.escape(k)}\b", msg) for k in params):
+            raise ValueError(f"FeatureConfig.method_params: {msg}") from None
+    except Exception:  # noqa: BLE001 - anything else is for the real run to report
+        pass
 
 
 @dataclass(frozen=True)
@@ -154,6 +181,7 @@ class FeatureConfig:
             raise ValueError(
                 f"{name('use_mag')}: method {self.method!r} does not use a magnetometer"
             )
+        _dry_run(m, resolved, self.use_mag)
         choices = {
             "calibration_model": ("offsets", "ellipsoid"),
             "gyr_offset": ("auto", "none"),

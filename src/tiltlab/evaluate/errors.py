@@ -286,10 +286,20 @@ def table1(
     """
     if not errors:
         raise ValueError("errors is empty")
+    unknown = [s for s in statistics if s not in STATISTICS and s not in ("rmse", "n")]
+    if unknown:
+        raise ValueError(
+            f"statistics: unknown {unknown}; known: {[*STATISTICS, 'rmse', 'n']}"
+        )
     im = np.asarray(immobile, dtype=bool).ravel()
     cols = {}
     for state, m in (("immobile", im), ("moving", ~im)):
         for name, e in errors.items():
+            n_e = np.asarray(e).size
+            if im.size != n_e:
+                raise ValueError(
+                    f"immobile has {im.size} samples, errors[{name!r}] has {n_e}"
+                )
             st = error_stats(e, m)
             cols[(state, name)] = [st[s] for s in statistics]
     df = pd.DataFrame(cols, index=pd.Index(list(statistics), name="statistic"))
@@ -349,9 +359,15 @@ def binned_by_speed(errors: Mapping[str, Any], speed, edges) -> xr.Dataset:
         ``speed`` coordinate is the bin centre, ``speed_lo``/``speed_hi`` the edges.
     """
     edges = np.asarray(edges, dtype=float)
-    if edges.ndim != 1 or edges.size < 2 or np.any(np.diff(edges) <= 0):
+    if (
+        edges.ndim != 1
+        or edges.size < 2
+        or np.any(np.isnan(edges))
+        or np.any(np.diff(edges) <= 0)
+    ):
         raise ValueError(
-            "edges must be a 1-D increasing array with at least two values"
+            "edges must be a 1-D increasing array with at least two values, got "
+            f"{edges.tolist() if edges.size <= 10 else edges.shape}"
         )
     sp = np.asarray(speed, dtype=float).ravel()
     idx = np.digitize(sp, edges) - 1
@@ -419,6 +435,10 @@ def pairwise_tilt_rms(estimates: Mapping[str, Any], mask=None) -> xr.DataArray:
     if any(v.shape[0] != n for v in g.values()):
         raise ValueError("all estimates must have the same length")
     m = np.ones(n, bool) if mask is None else np.asarray(mask, bool)
+    if m.shape != (n,):
+        raise ValueError(
+            f"mask must have one value per sample ({n}), got shape {m.shape}"
+        )
     out = np.zeros((len(names), len(names)))
     for i, a in enumerate(names):
         for j in range(i + 1, len(names)):

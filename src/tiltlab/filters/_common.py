@@ -22,13 +22,24 @@ __all__ = [
 ]
 
 
-def samples(a, name: str, n: int | None = None) -> np.ndarray:
-    """A contiguous float (N, 3) copy of ``a``; NaN/inf and length mismatches raise.
+def samples(
+    a, name: str, n: int | None = None, *, nonzero: bool | None = None
+) -> np.ndarray:
+    """A contiguous float (N, 3) copy of ``a``; bad samples raise a ValueError naming
+    ``name``.
 
-    The message names ``name`` (and says NaN when there is NaN: the filters need finite
-    samples).
+    Refused: a wrong shape, no samples at all, NaN or infinite values (the filters need
+    finite samples: interpolate or split the recording, e.g. with
+    ``estimate(..., gaps="segments")``), a length other than ``n`` and, with
+    ``nonzero`` (default: for ``acc``), samples that are all zero (an accelerometer
+    that reads exactly zero throughout has no gravity direction: a disconnected sensor
+    or a zero-filled dropout).
     """
-    x = _v.vectors(a, name, width=3, ndim=2, allow_nan=True, min_length=1)
+    x = _v.vectors(a, name, width=3, ndim=2, allow_nan=True)
+    if x.shape[0] == 0:
+        raise ValueError(
+            f"{name} is empty (0 samples); the filters need at least one sample"
+        )
     k = int(np.isnan(x).sum())
     if k:
         raise ValueError(
@@ -37,20 +48,41 @@ def samples(a, name: str, n: int | None = None) -> np.ndarray:
         )
     if n is not None and x.shape[0] != n:
         raise ValueError(f"{name} has {x.shape[0]} samples, expected {n}")
+    if (name == "acc" if nonzero is None else nonzero) and not np.any(x):
+        what = "; no gravity direction can be defined" if name == "acc" else ""
+        raise ValueError(
+            f"{name} is zero in all {x.shape[0]} samples (a disconnected or "
+            f"zero-filled sensor?){what}"
+        )
     return np.ascontiguousarray(x)
+
+
+#: Angular rates (rad/s) above this are refused: about 100 times the range of MEMS
+#: gyroscopes (±2000–4000 °/s), far below where the kernels' arithmetic would overflow.
+MAX_GYR_RAD_S = 1.0e4
 
 
 def sensor_inputs(acc, gyr, mag=None):
     """``(acc, gyr, mag_or_dummy, use_mag)`` as contiguous (N, 3) arrays for the kernels.
 
+    Every filter and adapter reads its arrays here (or through :func:`samples`), so
+    that they all refuse the same inputs: empty arrays, non-finite samples, mismatched
+    lengths, an ``acc`` (or a given ``mag``) that is zero in every sample, and angular
+    rates above :data:`MAX_GYR_RAD_S`.
     Without a magnetometer, a (1, 3) zero array stands in for ``mag`` (the kernels take
     an array in every case) and ``use_mag`` is False.
     """
-    acc = samples(acc, "acc")
+    acc = samples(acc, "acc", nonzero=True)
     gyr = samples(gyr, "gyr", acc.shape[0])
+    peak = float(np.abs(gyr).max())
+    if peak > MAX_GYR_RAD_S:
+        raise ValueError(
+            f"gyr reaches {peak:.3g} rad/s ({np.degrees(peak):.3g} deg/s), beyond any "
+            f"gyroscope (limit {MAX_GYR_RAD_S:g} rad/s): check its units or scale"
+        )
     if mag is None:
         return acc, gyr, np.zeros((1, 3)), False
-    return acc, gyr, samples(mag, "mag", acc.shape[0]), True
+    return acc, gyr, samples(mag, "mag", acc.shape[0], nonzero=True), True
 
 
 def init_samples(init_window_s: float, fs: float) -> int:

@@ -10,6 +10,7 @@ the two together plus the labelling. Parameter searches
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 from typing import Any
 
@@ -44,7 +45,9 @@ class Inputs:
         return self.mag is not None
 
 
-def prepare(recording: xr.Dataset, *, use_mag: bool = False) -> Inputs:
+def prepare(
+    recording: xr.Dataset, *, use_mag: bool = False, allow_nan: bool = False
+) -> Inputs:
     """Read a Recording's ``acc``, ``gyr`` (and ``mag``) in SI units.
 
     Parameters
@@ -54,12 +57,23 @@ def prepare(recording: xr.Dataset, *, use_mag: bool = False) -> Inputs:
         optional ``mag``; attrs ``fs``.
     use_mag : bool
         Also read ``mag`` (9D).
+    allow_nan : bool
+        Accept NaN samples (dropouts), e.g. to split the recording into segments with
+        :func:`tiltlab._validate.segments` (as ``estimate(..., gaps="segments")``
+        does); the kernels themselves refuse NaN. Infinite values are always refused.
 
     Raises
     ------
     tiltlab._validate.RecordingError
         A missing variable, ``fs`` or unit, an ``fs`` contradicting the time axis, or
         non-finite samples.
+
+    Notes
+    -----
+    The ``fs``/time-axis check compares the *median* time step with ``1/fs``: a time
+    axis with a few long steps (dropped samples) passes here. :func:`estimate` looks
+    for such gaps (``gaps=``); code that calls :func:`run` directly should too
+    (:func:`tiltlab._validate.segments`).
     """
     if not isinstance(recording, xr.Dataset):
         raise _v.RecordingError(
@@ -74,9 +88,9 @@ def prepare(recording: xr.Dataset, *, use_mag: bool = False) -> Inputs:
     rec = recording[names]
     if "time" in rec.dims:
         rec = rec.transpose("time", ...)
-    acc = _v.signal(rec, "acc", to_units="m/s^2")
-    gyr = _v.signal(rec, "gyr", to_units="rad/s")
-    mag = _v.signal(rec, "mag").values if use_mag else None
+    acc = _v.signal(rec, "acc", to_units="m/s^2", allow_nan=allow_nan)
+    gyr = _v.signal(rec, "gyr", to_units="rad/s", allow_nan=allow_nan)
+    mag = _v.signal(rec, "mag", allow_nan=allow_nan).values if use_mag else None
 
     def c(a):
         return None if a is None else np.ascontiguousarray(a, dtype=np.float64)
@@ -106,8 +120,25 @@ def attr_value(v):
     return v
 
 
+#: values of ``estimate(..., gaps=)``
+GAP_POLICIES = ("raise", "segments")
+
+
+def _time_axis(inputs: Inputs) -> np.ndarray:
+    t = inputs.like.time
+    if t is None or t.shape != (inputs.acc.shape[0],):
+        return np.arange(inputs.acc.shape[0]) / inputs.fs
+    return t
+
+
 def estimate(
-    recording: xr.Dataset, method: str, *, use_mag: bool = False, **params
+    recording: xr.Dataset,
+    method: str,
+    *,
+    use_mag: bool = False,
+    gaps: str = "raise",
+    min_segment_s: float = 1.0,
+    **params,
 ) -> xr.DataArray:
     """Estimate the orientation of a Recording with a registered method.
 
@@ -123,6 +154,19 @@ def estimate(
         A name of :data:`tiltlab.filters.METHODS` (:func:`tiltlab.filters.methods`).
     use_mag : bool
         Use the magnetometer (9D, ENU world frame).
+    gaps : {"raise", "segments"}
+        What to do with gaps: time steps longer than 1.5/``fs`` (dropped samples) and
+        samples where ``acc``, ``gyr`` (or ``mag``, with ``use_mag``) are not finite
+        (:func:`tiltlab._validate.segments`). ``"raise"`` (default): a
+        :class:`~tiltlab._validate.RecordingError` saying where they are — a filter
+        integrating the gyroscope across a gap would be silently wrong. ``"segments"``:
+        estimate each contiguous segment separately, each from its own initial
+        orientation exactly as if it were a Recording of its own (a ``q0`` given in
+        ``params`` starts every segment); samples in gaps and in segments shorter
+        than ``min_segment_s`` are NaN, with a :class:`RuntimeWarning` saying how many.
+    min_segment_s : float
+        Shortest segment estimated with ``gaps="segments"`` (s; its number of samples
+        over ``fs``). It applies to a gap-free recording too.
     **params
         Method parameters; unspecified ones take the registry's defaults (the
         function's signature), and all are recorded in the output's attrs.
@@ -132,7 +176,19 @@ def estimate(
     xarray.DataArray, dims (time, quat)
         ``q``: unit quaternions sensor → world, with the Recording's ``time``
         coordinate and attrs ``fs``, ``method``, ``use_mag``, ``world_frame`` and every
-        parameter as ``param_<name>``.
+        parameter as ``param_<name>``. With ``gaps="segments"`` also ``gaps``,
+        ``min_segment_s``, ``n_segments`` (segments estimated) and ``segments``: the
+        times (s) of the first and last sample of each estimated segment, flattened
+        ``[start_0, last_0, start_1, last_1, ...]``.
+
+    Raises
+    ------
+    tiltlab._validate.RecordingError
+        With ``gaps="raise"``, a recording with gaps (and, whatever ``gaps``, the
+        problems :func:`prepare` reports).
+    ValueError
+        An unknown method, parameter or ``gaps`` value, or a negative
+        ``min_segment_s``.
     """
     m = get_method(method)
     if use_mag and not m.supports_mag:
@@ -140,9 +196,15 @@ def estimate(
             f"method {method!r} does not use a magnetometer; "
             "use_mag=True is not supported"
         )
+    if not isinstance(gaps, str) or gaps not in GAP_POLICIES:
+        raise ValueError(f"gaps must be one of {GAP_POLICIES}, got {gaps!r}")
+    min_segment_s = _v.nonnegative(min_segment_s, "min_segment_s")
     full = m.resolve(params)
-    inputs = prepare(recording, use_mag=use_mag)
-    q = m(inputs.acc, inputs.gyr, inputs.fs, inputs.mag, **full)
+    inputs = prepare(recording, use_mag=use_mag, allow_nan=True)
+    n = inputs.acc.shape[0]
+    time = _time_axis(inputs)
+    stacked = [inputs.acc, inputs.gyr] + ([inputs.mag] if use_mag else [])
+    segs = _v.segments(time, inputs.fs, values=np.concatenate(stacked, axis=1))
     attrs: dict[str, Any] = {
         "method": method,
         "use_mag": int(bool(use_mag)),
@@ -151,6 +213,46 @@ def estimate(
         "world_frame": "ENU" if use_mag else "z up, heading arbitrary",
         **{f"param_{k}": attr_value(v) for k, v in full.items()},
     }
+    if gaps == "raise" and n and segs != [(0, n)]:
+        names = "acc, gyr" + (", mag" if use_mag else "")
+        raise _v.RecordingError(
+            f"the Recording has gaps (time steps longer than 1.5/fs = "
+            f"{1.5 / inputs.fs:.3g} s, or non-finite {names} samples): "
+            f"{_v.describe_gaps(time, inputs.fs, segs)}; the filters would "
+            'integrate across them. Pass gaps="segments" to estimate each '
+            "contiguous segment separately (NaN in the gaps), or repair the "
+            "recording"
+        )
+    if gaps == "raise" or n == 0:  # (an empty recording: the method says so)
+        q = m(inputs.acc, inputs.gyr, inputs.fs, inputs.mag, **full)
+    else:
+        q = np.full((n, 4), np.nan)
+        kept = []
+        for a, b in segs:
+            if (b - a) / inputs.fs < min_segment_s:
+                continue
+            mag = None if inputs.mag is None else inputs.mag[a:b]
+            q[a:b] = m(inputs.acc[a:b], inputs.gyr[a:b], inputs.fs, mag, **full)
+            kept.append((a, b))
+        left = int(np.isnan(q[:, 0]).sum())
+        if left:
+            short = len(segs) - len(kept)
+            warnings.warn(
+                f"estimate({method!r}, gaps='segments'): {left} of {n} samples left "
+                f"NaN ({_v.describe_gaps(time, inputs.fs, segs)}; {short} "
+                f"segment{'s' if short != 1 else ''} shorter than min_segment_s = "
+                f"{min_segment_s:g} s)",
+                RuntimeWarning,
+                stacklevel=2,
+            )
+        attrs.update(
+            gaps=gaps,
+            min_segment_s=min_segment_s,
+            n_segments=len(kept),
+            segments=np.array(
+                [time[i] for a, b in kept for i in (a, b - 1)], dtype=float
+            ),
+        )
     return _v.labelled(
         q,
         inputs.like,

@@ -172,6 +172,160 @@ def _rts_boxminus(w, x, y, z, rw, rx, ry, rz):
 
 
 @njit(cache=True, nogil=True)
+def _rts_forward_step(
+    k,
+    acc,
+    gyr,
+    rest,
+    dt,
+    grav,
+    Qd,
+    var_acc,
+    norm_gain,
+    var_vel,
+    var_pos,
+    var_zupt,
+    q,
+    x,
+    P,
+    q_pred,
+    x_pred,
+    Pt,
+    F,
+    FP,
+    R,
+    h,
+    Ph,
+    dx,
+):
+    # one sample of the forward filter: the posterior (q, x, P) at k-1 becomes the one at k,
+    # in place; the prediction q_{k|k-1}, x_{k|k-1} is written to q_pred, x_pred
+    n = _RTS_N
+    w, qx, qy, qz = q[0], q[1], q[2], q[3]
+    # ---- prediction with ω_k, a_k (nominal state, then error covariance)
+    # ω_c = (ω_k − b) / (1 + s): gyro corrected for bias and scale error
+    wc0 = (gyr[k, 0] - x[0]) / (1.0 + x[9])
+    wc1 = (gyr[k, 1] - x[1]) / (1.0 + x[10])
+    wc2 = (gyr[k, 2] - x[2]) / (1.0 + x[11])
+    w, qx, qy, qz = zoh_step_scalar(w, qx, qy, qz, wc0 * dt, wc1 * dt, wc2 * dt)
+    nq = np.sqrt(w * w + qx * qx + qy * qy + qz * qz)
+    w, qx, qy, qz = w / nq, qx / nq, qy / nq, qz / nq
+    sx, sy, sz = _rts_transition(w, qx, qy, qz, acc[k], wc0, wc1, wc2, dt, R, F)
+    fz = sz - grav
+    # nominal: p ← p + Δt v + Δt²/2 f, v ← v + Δt f, f = R(q) a_k − g e_z
+    # (nominal x = (b, v, p, s): b = x[0:3], v = x[3:6], p = x[6:9], s = x[9:12])
+    x[6] += dt * x[3] + 0.5 * dt * dt * sx
+    x[7] += dt * x[4] + 0.5 * dt * dt * sy
+    x[8] += dt * x[5] + 0.5 * dt * dt * fz
+    x[3] += dt * sx
+    x[4] += dt * sy
+    x[5] += dt * fz
+    _rts_propagate(F, P, Qd, FP, Pt)
+    for i in range(n):
+        for j in range(n):
+            P[i, j] = Pt[i, j]
+    q_pred[0], q_pred[1], q_pred[2], q_pred[3] = w, qx, qy, qz
+    for i in range(_RTS_X):
+        x_pred[i] = x[i]
+    # ---- sequential scalar updates of the error state δx (exact for diagonal noise)
+    for i in range(n):
+        dx[i] = 0.0
+    vv = var_zupt if rest[k] else var_vel
+    if vv > 0.0 and np.isfinite(vv):
+        for i in range(3):
+            h[:] = 0.0
+            h[6 + i] = 1.0
+            _rts_scalar_update(P, h, -x[3 + i], vv, dx, Ph)
+    if var_pos > 0.0 and np.isfinite(var_pos):
+        for i in range(3):
+            h[:] = 0.0
+            h[9 + i] = 1.0
+            _rts_scalar_update(P, h, -x[6 + i], var_pos, dx, Ph)
+    an = np.sqrt(acc[k, 0] ** 2 + acc[k, 1] ** 2 + acc[k, 2] ** 2)
+    if an > 0.0 and var_acc > 0.0 and np.isfinite(var_acc):
+        e = norm_gain * (an - grav) / grav
+        va = var_acc * (1.0 + e * e)
+        # ĝ = R(q)ᵀ e_z (third row of R);  ∂ĝ/∂δφ = Rᵀ [e_z]×
+        for i in range(3):
+            h[:] = 0.0
+            h[0] = R[1, i]
+            h[1] = -R[0, i]
+            _rts_scalar_update(P, h, acc[k, i] / an - R[2, i], va, dx, Ph)
+    # ---- injection: q ← exp(δφ/2) ⊗ q, (b, v, p, s) += δ
+    w, qx, qy, qz = _rts_boxplus(w, qx, qy, qz, dx[0], dx[1], dx[2])
+    for i in range(_RTS_X):
+        x[i] += dx[3 + i]
+    for i in range(n):
+        for j in range(i + 1, n):
+            s = 0.5 * (P[i, j] + P[j, i])
+            P[i, j] = s
+            P[j, i] = s
+    q[0], q[1], q[2], q[3] = w, qx, qy, qz
+
+
+@njit(cache=True, nogil=True)
+def _rts_backward_step(
+    acc1,
+    gyr1,
+    dt,
+    Qd,
+    q_f,
+    x_f,
+    P_f,
+    q_p1,
+    x_p1,
+    qs,
+    xs,
+    R,
+    F,
+    FP,
+    Pt,
+    C,
+    Lw,
+    sc,
+    d,
+    dx,
+):
+    # one Rauch–Tung–Striebel step on the error state: the smoothed (qs, xs) at k+1 become
+    # the ones at k, in place. acc1, gyr1: the samples k+1; q_f, x_f, P_f: the forward
+    # posterior at k; q_p1, x_p1: the forward prediction at k+1
+    n = _RTS_N
+    wc0 = (gyr1[0] - x_f[0]) / (1.0 + x_f[9])
+    wc1 = (gyr1[1] - x_f[1]) / (1.0 + x_f[10])
+    wc2 = (gyr1[2] - x_f[2]) / (1.0 + x_f[11])
+    _rts_transition(q_p1[0], q_p1[1], q_p1[2], q_p1[3], acc1, wc0, wc1, wc2, dt, R, F)
+    _rts_propagate(F, P_f, Qd, FP, Pt)
+    d[0], d[1], d[2] = _rts_boxminus(
+        qs[0], qs[1], qs[2], qs[3], q_p1[0], q_p1[1], q_p1[2], q_p1[3]
+    )
+    for i in range(_RTS_X):
+        d[3 + i] = xs[i] - x_p1[i]
+    # δ = G d with G = P_k|k Fᵀ P_{k+1|k}⁻¹:  solve P_{k+1|k} y = d, then δ = (F P_k|k)ᵀ y;
+    # the solve after a symmetric diagonal (Jacobi) scaling, the states' variances
+    # differing by many decades
+    for i in range(n):
+        sc[i] = 1.0 / np.sqrt(Pt[i, i])
+    for i in range(n):
+        C[i, 0] = d[i] * sc[i]
+        for j in range(n):
+            Pt[i, j] *= sc[i] * sc[j]
+    if not _rts_chol_solve(Pt, C[:, :1], Lw):  # not numerically positive definite: LU
+        C[:, :1] = np.linalg.solve(Pt, np.ascontiguousarray(C[:, :1]))
+    for i in range(n):
+        C[i, 0] *= sc[i]
+    for i in range(n):
+        s = 0.0
+        for j in range(n):
+            s += FP[j, i] * C[j, 0]
+        dx[i] = s
+    qs[0], qs[1], qs[2], qs[3] = _rts_boxplus(
+        q_f[0], q_f[1], q_f[2], q_f[3], dx[0], dx[1], dx[2]
+    )
+    for i in range(_RTS_X):
+        xs[i] = x_f[i] + dx[3 + i]
+
+
+@njit(cache=True, nogil=True)
 def _rts_kernel(
     acc,
     gyr,
@@ -188,17 +342,36 @@ def _rts_kernel(
     var_pos,
     var_zupt,
     smooth,
+    ckpt_q,
+    ckpt_x,
+    ckpt_P,
+    blk_qf,
+    blk_xf,
+    blk_qp,
+    blk_xp,
+    blk_Pf,
     out_q,
     out_x,
 ):
+    # forward filter, then (``smooth``) the backward pass over blocks of B samples, last
+    # block first. The forward pass keeps its posterior (q, x, P) only every B samples
+    # (checkpoint j at sample j·B; ckpt_* have ⌈N/B⌉ rows); each block is recomputed from
+    # its checkpoint into blk_* (B + 1 rows: the block and the first sample of the next,
+    # whose prediction the block's last backward step needs) and smoothed backwards. The
+    # recomputation repeats the same floating-point operations, so the result equals that
+    # of storing every sample. Without checkpoints (ckpt_* with 0 rows) the single block
+    # holds every sample (N rows) and the forward pass is not repeated: the full-storage
+    # smoother.
+    # out_x: (N, 12), or (0, 12) when the states are not returned.
     n_s = acc.shape[0]
     n = _RTS_N
-    qf = np.empty((n_s, 4))
-    xf = np.empty((n_s, _RTS_X))
-    qp = np.empty((n_s, 4))
-    xp = np.empty((n_s, _RTS_X))
-    Pf = np.empty((n_s, n, n)) if smooth else np.empty((1, n, n))
+    store_x = out_x.shape[0] > 0
+    one = ckpt_q.shape[0] == 0  # one block, no checkpoints
+    nb = 1 if one else ckpt_q.shape[0]
+    blk = blk_qf.shape[0] - 1
     P = P0.copy()
+    x = x0.copy()
+    q = q0.copy()
     Pt = np.empty((n, n))
     F = np.empty((n, n))
     FP = np.empty((n, n))
@@ -206,145 +379,261 @@ def _rts_kernel(
     h = np.zeros(n)
     Ph = np.empty(n)
     dx = np.empty(n)
-    x = x0.copy()
-    w, qx, qy, qz = q0[0], q0[1], q0[2], q0[3]
-    qf[0, 0], qf[0, 1], qf[0, 2], qf[0, 3] = w, qx, qy, qz
-    qp[0, :] = qf[0, :]
-    xf[0, :] = x
-    xp[0, :] = x
-    if smooth:
-        Pf[0] = P
-    for k in range(1, n_s):
-        # ---- prediction with ω_k, a_k (nominal state, then error covariance)
-        # ω_c = (ω_k − b) / (1 + s): gyro corrected for bias and scale error
-        wc0 = (gyr[k, 0] - x[0]) / (1.0 + x[9])
-        wc1 = (gyr[k, 1] - x[1]) / (1.0 + x[10])
-        wc2 = (gyr[k, 2] - x[2]) / (1.0 + x[11])
-        w, qx, qy, qz = zoh_step_scalar(w, qx, qy, qz, wc0 * dt, wc1 * dt, wc2 * dt)
-        nq = np.sqrt(w * w + qx * qx + qy * qy + qz * qz)
-        w, qx, qy, qz = w / nq, qx / nq, qy / nq, qz / nq
-        sx, sy, sz = _rts_transition(w, qx, qy, qz, acc[k], wc0, wc1, wc2, dt, R, F)
-        fz = sz - grav
-        # nominal: p ← p + Δt v + Δt²/2 f, v ← v + Δt f, f = R(q) a_k − g e_z
-        # (nominal x = (b, v, p, s): b = x[0:3], v = x[3:6], p = x[6:9], s = x[9:12])
-        x[6] += dt * x[3] + 0.5 * dt * dt * sx
-        x[7] += dt * x[4] + 0.5 * dt * dt * sy
-        x[8] += dt * x[5] + 0.5 * dt * dt * fz
-        x[3] += dt * sx
-        x[4] += dt * sy
-        x[5] += dt * fz
-        _rts_propagate(F, P, Qd, FP, Pt)
-        for i in range(n):
-            for j in range(n):
-                P[i, j] = Pt[i, j]
-        qp[k, 0], qp[k, 1], qp[k, 2], qp[k, 3] = w, qx, qy, qz
-        for i in range(_RTS_X):
-            xp[k, i] = x[i]
-        # ---- sequential scalar updates of the error state δx (exact for diagonal noise)
-        for i in range(n):
-            dx[i] = 0.0
-        vv = var_zupt if rest[k] else var_vel
-        if vv > 0.0 and np.isfinite(vv):
-            for i in range(3):
-                h[:] = 0.0
-                h[6 + i] = 1.0
-                _rts_scalar_update(P, h, -x[3 + i], vv, dx, Ph)
-        if var_pos > 0.0 and np.isfinite(var_pos):
-            for i in range(3):
-                h[:] = 0.0
-                h[9 + i] = 1.0
-                _rts_scalar_update(P, h, -x[6 + i], var_pos, dx, Ph)
-        an = np.sqrt(acc[k, 0] ** 2 + acc[k, 1] ** 2 + acc[k, 2] ** 2)
-        if an > 0.0 and var_acc > 0.0 and np.isfinite(var_acc):
-            e = norm_gain * (an - grav) / grav
-            va = var_acc * (1.0 + e * e)
-            # ĝ = R(q)ᵀ e_z (third row of R);  ∂ĝ/∂δφ = Rᵀ [e_z]×
-            for i in range(3):
-                h[:] = 0.0
-                h[0] = R[1, i]
-                h[1] = -R[0, i]
-                _rts_scalar_update(P, h, acc[k, i] / an - R[2, i], va, dx, Ph)
-        # ---- injection: q ← exp(δφ/2) ⊗ q, (b, v, p, s) += δ
-        w, qx, qy, qz = _rts_boxplus(w, qx, qy, qz, dx[0], dx[1], dx[2])
-        for i in range(_RTS_X):
-            x[i] += dx[3 + i]
-        for i in range(n):
-            for j in range(i + 1, n):
-                s = 0.5 * (P[i, j] + P[j, i])
-                P[i, j] = s
-                P[j, i] = s
-        qf[k, 0], qf[k, 1], qf[k, 2], qf[k, 3] = w, qx, qy, qz
-        for i in range(_RTS_X):
-            xf[k, i] = x[i]
-        if smooth:
-            Pf[k] = P
-    if not smooth:
-        out_q[:, :] = qf
-        out_x[:, :] = xf
+    qp1 = np.empty(4)
+    xp1 = np.empty(_RTS_X)
+    if not smooth:  # forward filter only: nothing stored
+        out_q[0, :] = q
+        if store_x:
+            out_x[0, :] = x
+        for k in range(1, n_s):
+            _rts_forward_step(
+                k,
+                acc,
+                gyr,
+                rest,
+                dt,
+                grav,
+                Qd,
+                var_acc,
+                norm_gain,
+                var_vel,
+                var_pos,
+                var_zupt,
+                q,
+                x,
+                P,
+                qp1,
+                xp1,
+                Pt,
+                F,
+                FP,
+                R,
+                h,
+                Ph,
+                dx,
+            )
+            out_q[k, :] = q
+            if store_x:
+                out_x[k, :] = x
         return
-    # ---- Rauch–Tung–Striebel backward pass on the error state
-    out_q[n_s - 1, :] = qf[n_s - 1, :]
-    out_x[n_s - 1, :] = xf[n_s - 1, :]
+    if one:  # the single block is filled by the first (only) forward pass
+        blk_qf[0, :] = q
+        blk_xf[0, :] = x
+        blk_qp[0, :] = q
+        blk_xp[0, :] = x
+        blk_Pf[0] = P
+    else:
+        ckpt_q[0, :] = q
+        ckpt_x[0, :] = x
+        ckpt_P[0] = P
+        blk_qp[0, :] = q  # (unused: a block's first prediction is never read)
+        blk_xp[0, :] = x
+    for k in range(1, n_s):
+        if one:
+            _rts_forward_step(
+                k,
+                acc,
+                gyr,
+                rest,
+                dt,
+                grav,
+                Qd,
+                var_acc,
+                norm_gain,
+                var_vel,
+                var_pos,
+                var_zupt,
+                q,
+                x,
+                P,
+                blk_qp[k],
+                blk_xp[k],
+                Pt,
+                F,
+                FP,
+                R,
+                h,
+                Ph,
+                dx,
+            )
+            blk_qf[k, :] = q
+            blk_xf[k, :] = x
+            blk_Pf[k] = P
+        else:
+            _rts_forward_step(
+                k,
+                acc,
+                gyr,
+                rest,
+                dt,
+                grav,
+                Qd,
+                var_acc,
+                norm_gain,
+                var_vel,
+                var_pos,
+                var_zupt,
+                q,
+                x,
+                P,
+                qp1,
+                xp1,
+                Pt,
+                F,
+                FP,
+                R,
+                h,
+                Ph,
+                dx,
+            )
+            if k % blk == 0:
+                j = k // blk
+                ckpt_q[j, :] = q
+                ckpt_x[j, :] = x
+                ckpt_P[j] = P
+    # ---- Rauch–Tung–Striebel backward pass on the error state, block by block
+    qs = q.copy()  # smoothed = filtered at the last sample
+    xs = x.copy()
+    out_q[n_s - 1, :] = qs
+    if store_x:
+        out_x[n_s - 1, :] = xs
     C = np.empty((n, n))
     Lw = np.zeros((n, n))
     sc = np.empty(n)
     d = np.empty(n)
-    for k in range(n_s - 2, -1, -1):
-        wc0 = (gyr[k + 1, 0] - xf[k, 0]) / (1.0 + xf[k, 9])
-        wc1 = (gyr[k + 1, 1] - xf[k, 1]) / (1.0 + xf[k, 10])
-        wc2 = (gyr[k + 1, 2] - xf[k, 2]) / (1.0 + xf[k, 11])
-        _rts_transition(
-            qp[k + 1, 0],
-            qp[k + 1, 1],
-            qp[k + 1, 2],
-            qp[k + 1, 3],
-            acc[k + 1],
-            wc0,
-            wc1,
-            wc2,
-            dt,
-            R,
-            F,
-        )
-        Pk = Pf[k]
-        _rts_propagate(F, Pk, Qd, FP, Pt)
-        d[0], d[1], d[2] = _rts_boxminus(
-            out_q[k + 1, 0],
-            out_q[k + 1, 1],
-            out_q[k + 1, 2],
-            out_q[k + 1, 3],
-            qp[k + 1, 0],
-            qp[k + 1, 1],
-            qp[k + 1, 2],
-            qp[k + 1, 3],
-        )
-        for i in range(_RTS_X):
-            d[3 + i] = out_x[k + 1, i] - xp[k + 1, i]
-        # δ = G d with G = P_k|k Fᵀ P_{k+1|k}⁻¹:  solve P_{k+1|k} y = d, then δ = (F P_k|k)ᵀ y;
-        # the solve after a symmetric diagonal (Jacobi) scaling, the states' variances
-        # differing by many decades
-        for i in range(n):
-            sc[i] = 1.0 / np.sqrt(Pt[i, i])
-        for i in range(n):
-            C[i, 0] = d[i] * sc[i]
-            for j in range(n):
-                Pt[i, j] *= sc[i] * sc[j]
-        if not _rts_chol_solve(
-            Pt, C[:, :1], Lw
-        ):  # not numerically positive definite: LU
-            C[:, :1] = np.linalg.solve(Pt, np.ascontiguousarray(C[:, :1]))
-        for i in range(n):
-            C[i, 0] *= sc[i]
-        for i in range(n):
-            s = 0.0
-            for j in range(n):
-                s += FP[j, i] * C[j, 0]
-            dx[i] = s
-        out_q[k, 0], out_q[k, 1], out_q[k, 2], out_q[k, 3] = _rts_boxplus(
-            qf[k, 0], qf[k, 1], qf[k, 2], qf[k, 3], dx[0], dx[1], dx[2]
-        )
-        for i in range(_RTS_X):
-            out_x[k, i] = xf[k, i] + dx[3 + i]
+    for j in range(nb - 1, -1, -1):
+        s0 = j * blk
+        top = min(s0 + blk, n_s - 1)
+        if not one:  # recompute the block's forward pass from its checkpoint
+            q[:] = ckpt_q[j]
+            x[:] = ckpt_x[j]
+            P[:, :] = ckpt_P[j]
+            blk_qf[0, :] = q
+            blk_xf[0, :] = x
+            blk_Pf[0] = P
+            for k in range(s0 + 1, top + 1):
+                i = k - s0
+                _rts_forward_step(
+                    k,
+                    acc,
+                    gyr,
+                    rest,
+                    dt,
+                    grav,
+                    Qd,
+                    var_acc,
+                    norm_gain,
+                    var_vel,
+                    var_pos,
+                    var_zupt,
+                    q,
+                    x,
+                    P,
+                    blk_qp[i],
+                    blk_xp[i],
+                    Pt,
+                    F,
+                    FP,
+                    R,
+                    h,
+                    Ph,
+                    dx,
+                )
+                blk_qf[i, :] = q
+                blk_xf[i, :] = x
+                blk_Pf[i] = P
+        for k in range(top - 1, s0 - 1, -1):
+            i = k - s0
+            _rts_backward_step(
+                acc[k + 1],
+                gyr[k + 1],
+                dt,
+                Qd,
+                blk_qf[i],
+                blk_xf[i],
+                blk_Pf[i],
+                blk_qp[i + 1],
+                blk_xp[i + 1],
+                qs,
+                xs,
+                R,
+                F,
+                FP,
+                Pt,
+                C,
+                Lw,
+                sc,
+                d,
+                dx,
+            )
+            out_q[k, :] = qs
+            if store_x:
+                out_x[k, :] = xs
+
+
+#: samples per block of the checkpointed backward pass (see :func:`_rts_plan`; ``None``:
+#: store every sample, the full-storage smoother)
+_RTS_BLOCK: int | None = 2**14
+#: bytes per sample of the block's forward quantities: q, x filtered and predicted, P filtered
+_RTS_BLOCK_SAMPLE_BYTES = 8 * (2 * (4 + _RTS_X) + _RTS_N * _RTS_N)  # 2056
+#: bytes per checkpoint: q, x, P filtered
+_RTS_CKPT_BYTES = 8 * (4 + _RTS_X + _RTS_N * _RTS_N)  # 1928
+
+
+def _rts_plan(
+    n_samples: int,
+    block: int | None,
+    *,
+    smooth: bool = True,
+    return_state: bool = False,
+) -> dict:
+    """The arrays :func:`rts_smoother` allocates for ``n_samples`` samples: their shapes
+    (``shapes``: name → shape, every array float64) and bytes.
+
+    ``block``: samples per block of the backward pass (:func:`rts_smoother` uses
+    :data:`_RTS_BLOCK`); ``None`` or ``≥ n_samples − 1``: one block, i.e. the
+    full-storage smoother without checkpoints. Keys: ``block`` (B), ``checkpoints``
+    (⌈N/B⌉, 0 for one block), ``shapes``, ``checkpoint_bytes``, ``block_bytes``
+    (independent of N once N > B), ``output_bytes`` and ``total_bytes``.
+    """
+    n_s = int(n_samples)
+    if block is not None and (int(block) != block or block < 1):
+        raise ValueError(f"block must be a positive integer or None, got {block!r}")
+    blk = n_s if block is None else int(block)
+    if not smooth:
+        nb, blk, rows = 0, 0, 0
+    elif blk >= n_s - 1:  # one block: the full-storage smoother
+        blk = max(n_s - 1, 1)
+        nb, rows = 1, n_s
+    else:
+        nb, rows = -(-n_s // blk), blk + 1
+    ck = 0 if nb <= 1 else nb
+    n = _RTS_N
+    shapes = {
+        "ckpt_q": (ck, 4),
+        "ckpt_x": (ck, _RTS_X),
+        "ckpt_P": (ck, n, n),
+        "blk_qf": (rows, 4),
+        "blk_xf": (rows, _RTS_X),
+        "blk_qp": (rows, 4),
+        "blk_xp": (rows, _RTS_X),
+        "blk_Pf": (rows, n, n),
+        "out_q": (n_s, 4),
+        "out_x": (n_s if return_state else 0, _RTS_X),
+    }
+    nbytes = {k: 8 * int(np.prod(v)) for k, v in shapes.items()}
+    plan = {
+        "block": blk,
+        "checkpoints": ck,
+        "shapes": shapes,
+        "checkpoint_bytes": sum(v for k, v in nbytes.items() if k.startswith("ckpt")),
+        "block_bytes": sum(v for k, v in nbytes.items() if k.startswith("blk")),
+        "output_bytes": nbytes["out_q"] + nbytes["out_x"],
+    }
+    plan["total_bytes"] = (
+        plan["checkpoint_bytes"] + plan["block_bytes"] + plan["output_bytes"]
+    )
+    return plan
 
 
 def rts_smoother(
@@ -425,8 +714,9 @@ def rts_smoother(
 
     where :math:`\boxminus` of attitudes is :math:`\mathrm{Log}(q^s \otimes
     \hat q^{-1})`; :math:`G_k` is solved after a symmetric diagonal scaling of
-    :math:`P_{k+1|k}`. Memory: one 15 × 15 covariance per sample (1.8 kB). Like ``offlineVQF`` (Laidig & Seel [3]_) it uses past and future
-    samples; unlike VQF the bias and the motion acceleration are handled by one
+    :math:`P_{k+1|k}`. The forward pass keeps its posterior only at checkpoints and the
+    backward pass recomputes it block by block, so memory stays bounded (see Notes).
+    Like ``offlineVQF`` (Laidig & Seel [3]_) it uses past and future samples; unlike VQF the bias and the motion acceleration are handled by one
     Gaussian model. 6D only: heading is relative (its error state is unobservable and
     merely carried).
 
@@ -472,13 +762,39 @@ def rts_smoother(
     return_state : bool
         Also return the (smoothed) states :math:`(b, v, p, s)`, shape (N, 12).
     max_memory_gb : float
-        Refuse recordings whose stored covariances would exceed this (1.8 kB per sample,
-        e.g. 0.65 GB for 20 min at 300 Hz); split longer recordings or raise the limit.
+        Refuse recordings whose arrays (outputs, checkpoints and one block, see Notes)
+        would exceed this: about 32 B per sample (128 B with ``return_state``) plus
+        34 MB, so the default 4 GB holds about 110 hours at 300 Hz (28 hours with
+        ``return_state``). Not checked with ``smooth=False``.
 
     Returns
     -------
     numpy.ndarray, shape (N, 4)
         Unit quaternions sensor → world (and the states if ``return_state``).
+
+    Notes
+    -----
+    **Memory.** A plain RTS smoother stores the forward posterior and prediction of
+    every sample: a 15 × 15 covariance plus two attitudes and two (b, v, p, s) states,
+    2056 B per sample (2.2 GB for one hour at 300 Hz). Here the forward pass keeps its
+    posterior :math:`(q, x, P)` only every :math:`B = 2^{14}` samples (a *checkpoint*,
+    1928 B). The backward pass then takes the blocks of :math:`B` samples from the last
+    to the first: it restores the block's checkpoint, reruns the forward filter over
+    the block (storing its :math:`B + 1` posteriors and predictions, 2056 B each, 34 MB
+    in all) and runs the RTS recursion over it. Rerunning repeats the same
+    floating-point operations, so the result is that of storing every sample; the cost
+    is one more forward pass (about 1.5 × the run time of the full-storage smoother).
+    The smoother's own arrays are therefore
+
+    * the output: 32 B per sample (N × 4 quaternions), plus 96 B per sample for the
+      (N × 12) states with ``return_state``;
+    * the checkpoints: 1928 B per :math:`B` samples, 0.12 B per sample;
+    * one block: :math:`(B + 1) \times 2056` B = 34 MB, whatever the length,
+
+    e.g. 0.24 GB for 6 hours at 300 Hz (6.48 M samples; 0.86 GB with
+    ``return_state``), on top of the inputs and the transient arrays of the rest
+    detection (:func:`rest_gyro_bias`). Recordings of at most :math:`B + 1` samples
+    are smoothed in one block without checkpoints.
 
     References
     ----------
@@ -494,11 +810,18 @@ def rts_smoother(
     acc = samples(acc, "acc")
     gyr = samples(gyr, "gyr", acc.shape[0])
     max_memory_gb = _v.positive(max_memory_gb, "max_memory_gb", allow_inf=True)
-    need_gb = acc.shape[0] * 15 * 15 * 8 / 1e9
+    plan = _rts_plan(
+        acc.shape[0], _RTS_BLOCK, smooth=bool(smooth), return_state=bool(return_state)
+    )
+    need_gb = plan["total_bytes"] / 1e9
     if smooth and need_gb > max_memory_gb:
         raise ValueError(
-            f"rts_smoother would store {need_gb:.1f} GB of covariances for "
-            f"{acc.shape[0]} samples (limit max_memory_gb={max_memory_gb:g}); split "
+            f"rts_smoother would allocate {need_gb:.3g} GB for {acc.shape[0]} samples "
+            f"(limit max_memory_gb={max_memory_gb:g}): the output "
+            f"({plan['output_bytes'] / 1e9:.3g} GB, 32 B per sample, 128 B with "
+            f"return_state), {plan['checkpoints']} checkpoints "
+            f"({plan['checkpoint_bytes'] / 1e9:.3g} GB) and one block of "
+            f"{plan['block']} samples ({plan['block_bytes'] / 1e9:.3g} GB); split "
             "the recording into shorter segments or raise the limit"
         )
     dt = 1.0 / fs
@@ -555,8 +878,7 @@ def rts_smoother(
     )
     Qd = np.maximum(Qd, 1e-18)
     rate = tau_s * fs
-    out_q = np.empty((acc.shape[0], 4))
-    out_x = np.empty((acc.shape[0], 12))
+    arrays = {k: np.empty(v) for k, v in plan["shapes"].items()}
     _rts_kernel(
         acc,
         gyr,
@@ -573,7 +895,7 @@ def rts_smoother(
         std["pos_std"] ** 2 * rate,
         std["zupt_std"] ** 2,
         bool(smooth),
-        out_q,
-        out_x,
+        *arrays.values(),
     )
+    out_q, out_x = arrays["out_q"], arrays["out_x"]
     return (out_q, out_x) if return_state else out_q

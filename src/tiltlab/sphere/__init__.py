@@ -9,8 +9,9 @@ Submodules
   bootstrap confidence cones, the mean tilt point of a map and its angle to the sagittal
   plane (Fayat et al. §2.8, §3.3), rotation of a baseline to the pole (Fig. 3e);
 * :mod:`~tiltlab.sphere.kde` — equal-area grids, location- and movement-based vMF kernel
-  density estimation, reference bandwidth, cumulative isopleths, stationarity check
-  (Benhamou 2023, §7);
+  density estimation (mass-conserving on the grid by default: it integrates to 1 for
+  any bandwidth, even at the grid's poles), reference bandwidth, cumulative isopleths,
+  stationarity check (Benhamou 2023, §7);
 * :mod:`~tiltlab.sphere.residence` — residence time and number of visits
   (Benhamou 2023, App. C).
 

@@ -240,10 +240,13 @@ def spherical_triangle_area(a, b, c) -> np.ndarray:
     valid for any triangle (the atan2 keeps the right quadrant when the denominator is
     negative). Inputs broadcast over leading axes; they are normalised first.
     """
-    a, b, c = (np.asarray(x, float) for x in (a, b, c))
+    a, b, c = (
+        _validate.vectors(x, name, width=3, ndim=None, allow_nan=True)
+        for x, name in ((a, "a"), (b, "b"), (c, "c"))
+    )
     for name, x in zip("abc", (a, b, c)):
-        if x.shape[-1] != 3:
-            raise ValueError(f"{name} must have a last axis of length 3, got {x.shape}")
+        if np.any(np.all(x == 0, axis=-1)):
+            raise ValueError(f"{name} contains zero vectors (no direction)")
     a, b, c = (x / np.linalg.norm(x, axis=-1, keepdims=True) for x in (a, b, c))
     num = np.abs(np.einsum("...i,...i->...", a, np.cross(b, c)))
     den = (
@@ -315,7 +318,11 @@ def triangulate(vertices, *, lut_m: int | None = None) -> SphereMesh:
     """
     v = as_unit_vectors(vertices, "vertices")
     if v.shape[0] < 4:
-        raise ValueError("at least 4 vertices are needed")
+        raise ValueError(f"vertices needs at least 4 directions, got {v.shape[0]}")
+    if lut_m is not None:
+        lut_m = _validate.integer(lut_m, "lut_m", minimum=1)
+        if 6 * lut_m * lut_m > 100_000_000:
+            raise ValueError(f"lut_m = {lut_m} gives a table of 6·lut_m² > 1e8 cells")
     hull = ConvexHull(v)
     faces = hull.simplices.astype(np.int64).copy()
     nbr = hull.neighbors.astype(np.int64).copy()
@@ -360,7 +367,13 @@ def triangulate(vertices, *, lut_m: int | None = None) -> SphereMesh:
 
 @lru_cache(maxsize=8)
 def sphere_mesh(n: int = 5000) -> SphereMesh:
-    """The (cached) triangulated Fibonacci sphere with ``n`` vertices (Fayat et al. used n = 5000)."""
+    """The (cached) triangulated Fibonacci sphere with ``n`` vertices (Fayat et al. used n = 5000).
+
+    ``n`` is an integer in [4, 10⁷].
+    """
+    n = _validate.integer(n, "n", minimum=4)
+    if n > 10_000_000:
+        raise ValueError(f"n must be at most 1e7 vertices, got {n}")
     return triangulate(fibonacci_lattice(n))
 
 
@@ -514,7 +527,7 @@ def locate(vectors, mesh: SphereMesh | None = None):
         Facet index; a vector on a shared edge or vertex goes to the lowest-index facet
         containing it (closed facets, tolerance ``EDGE_EPS``), so each sample is counted once.
     """
-    mesh = sphere_mesh() if mesh is None else mesh
+    mesh = _check_mesh(mesh)
     sig = _read(vectors, allow_nan=True)
     return _validate.labelled(_locate(sig.values, mesh), sig, "facet", dims=("time",))
 
@@ -531,18 +544,47 @@ def _bincount(idx: np.ndarray, mesh: SphereMesh, weights) -> np.ndarray:
     w = np.asarray(weights, float)
     if w.shape != idx.shape:
         raise ValueError(f"weights must have shape {idx.shape}, got {w.shape}")
+    bad = ~np.isfinite(w[ok]) | (w[ok] < 0)
+    if np.any(bad):
+        raise ValueError(
+            f"weights must be finite and >= 0, got {int(bad.sum())} bad values "
+            f"(first: {w[ok][np.argmax(bad)]!r})"
+        )
     return np.bincount(idx[ok], weights=w[ok], minlength=mesh.n_faces)
+
+
+def _no_zero_rows(x: np.ndarray, name: str) -> np.ndarray:
+    """Zero rows (no direction) are an error naming ``name``; NaN rows (missing) pass."""
+    zero = np.all(x == 0, axis=1)
+    if np.any(zero):
+        raise ValueError(
+            f"{name} contains {int(zero.sum())} zero vectors (no direction; "
+            f"first at row {int(np.argmax(zero))}); mark missing samples with NaN"
+        )
+    return x
+
+
+def _check_mesh(mesh) -> SphereMesh:
+    if mesh is None:
+        return sphere_mesh()
+    if not isinstance(mesh, SphereMesh):
+        raise ValueError(
+            f"mesh must be a SphereMesh (sphere_mesh, triangulate), got {type(mesh).__name__}"
+        )
+    return mesh
 
 
 def histogram(vectors, mesh: SphereMesh | None = None, *, weights=None) -> np.ndarray:
     """Number of samples (or summed ``weights``) per facet, shape (F,).
 
     ``vectors`` is a labelled (time, axis) series, a Recording (its ``gravity``) or an
-    (N, 3) array. Rows that are NaN (e.g. masked samples) are ignored.
+    (N, 3) array. Rows that are NaN (e.g. masked samples) are ignored; zero rows (no
+    direction) and non-finite or negative ``weights`` are errors.
     """
-    mesh = sphere_mesh() if mesh is None else mesh
+    mesh = _check_mesh(mesh)
     sig = _read(vectors, allow_nan=True)
-    return _bincount(_locate(sig.values, mesh), mesh, weights)
+    x = _no_zero_rows(sig.values, "vectors")
+    return _bincount(_locate(x, mesh), mesh, weights)
 
 
 def tilt_map(
@@ -573,7 +615,7 @@ def tilt_map(
         kept samples), ``density`` = fraction / area (sr⁻¹; integrates to 1), ``time``
         (s, if the sampling rate is known), coords ``area`` (sr) and ``centroid``.
     """
-    mesh = sphere_mesh() if mesh is None else mesh
+    mesh = _check_mesh(mesh)
     sig = _read(vectors, fs=fs, need_fs=False, check_time=True, allow_nan=True)
     x = sig.values
     if mask is not None:
@@ -589,7 +631,7 @@ def tilt_map(
         if mask.shape != x.shape[:1]:
             raise ValueError(f"mask must have shape {x.shape[:1]}, got {mask.shape}")
         x = x[mask]
-    counts = _bincount(_locate(x, mesh), mesh, None)
+    counts = _bincount(_locate(_no_zero_rows(x, "vectors"), mesh), mesh, None)
     total = counts.sum()
     if total == 0:
         raise ValueError("no valid samples to map")
@@ -640,7 +682,7 @@ def visited_fraction(
     fraction of facets (Fayat et al.'s measure, which weights every facet equally even
     though their areas differ by :meth:`SphereMesh.area_ratio`).
     """
-    mesh = sphere_mesh() if mesh is None else mesh
+    mesh = _check_mesh(mesh)
     v = visited(tmap, min_count=min_count)
     if v.shape != (mesh.n_faces,):
         raise ValueError(f"map has {v.shape[0]} facets, mesh has {mesh.n_faces}")

@@ -162,7 +162,7 @@ def residence(
         ``attrs["fs"]`` is an error.
     ref_times : (M,), optional
         A time per centre (on the data's clock); ``residence`` is then the residence time
-        of the visit containing it.
+        of the visit containing it (NaN where a time is NaN).
 
     Returns
     -------
@@ -174,10 +174,14 @@ def residence(
     ref = (
         np.full(c.shape[0], np.nan)
         if ref_times is None
-        else np.asarray(ref_times, float)
+        else _validate.vectors(
+            ref_times, "ref_times", width=None, ndim=1, allow_nan=True
+        )
     )
     if ref.shape != (c.shape[0],):
-        raise ValueError("ref_times must have shape (M,)")
+        raise ValueError(
+            f"ref_times must have shape ({c.shape[0]},) (one per centre), got {ref.shape}"
+        )
     total, rt = np.empty(c.shape[0]), np.empty(c.shape[0])
     nv = np.empty(c.shape[0], np.int64)
     _residence_kernel(x, t, c, float(np.cos(radius)), float(t_out), ref, total, nv, rt)
@@ -219,6 +223,8 @@ def passage_times(
     """
     radius, _ = _check(radius, 0.0)
     x, t, _ = _series(vectors, fs, times)
+    if np.shape(centre) != (3,):
+        raise ValueError(f"centre must be one 3-vector, got shape {np.shape(centre)}")
     c = as_unit_vectors(centre, "centre")[0]
     inside = x @ c >= np.cos(radius)
     change = np.flatnonzero(np.diff(inside.astype(np.int8)))

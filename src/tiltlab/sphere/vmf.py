@@ -34,6 +34,7 @@ References
 
 from __future__ import annotations
 
+import warnings
 from typing import NamedTuple
 
 import numpy as np
@@ -85,9 +86,43 @@ class ConfidenceCone(NamedTuple):
 
 
 def angle(u, v) -> np.ndarray:
-    """Angle (rad) between directions, atan2(‖u×v‖, u·v) (accurate near 0 and π)."""
-    u, v = np.asarray(u, float), np.asarray(v, float)
+    """Angle (rad) between directions, atan2(‖u×v‖, u·v) (accurate near 0 and π).
+
+    ``u`` and ``v`` (..., 3) broadcast; NaN rows give NaN, a zero vector (no direction)
+    is an error naming ``u`` or ``v``.
+    """
+    u = _validate.vectors(u, "u", width=3, ndim=None, allow_nan=True)
+    v = _validate.vectors(v, "v", width=3, ndim=None, allow_nan=True)
+    for a, name in ((u, "u"), (v, "v")):
+        if np.any(np.all(a == 0, axis=-1)):
+            raise ValueError(f"{name} contains zero vectors (no direction)")
     return np.arctan2(np.linalg.norm(np.cross(u, v), axis=-1), np.sum(u * v, axis=-1))
+
+
+def _direction(v, name: str) -> np.ndarray:
+    """One direction (3,) as a unit vector; zero, non-finite or mis-shaped is an error naming it."""
+    try:
+        a = np.asarray(v, float)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be a 3-vector, got {v!r}") from None
+    if a.shape != (3,):
+        raise ValueError(f"{name} must be a 3-vector, got shape {a.shape}")
+    n = np.linalg.norm(a)
+    if not np.isfinite(n) or n == 0:
+        raise ValueError(
+            f"{name} must be a finite non-zero vector (a direction), got {a.tolist()}"
+        )
+    return a / n
+
+
+def _kappa_array(kappa, name: str = "kappa") -> np.ndarray:
+    k = np.asarray(kappa, float)
+    bad = np.isnan(k) | (k < 0)
+    if np.any(bad):
+        raise ValueError(
+            f"{name} must be >= 0 (and not NaN), got {k[bad].ravel()[0]!r}"
+        )
+    return k
 
 
 # ---------------------------------------------------------------------------
@@ -99,19 +134,19 @@ _SMALL = 1e-3
 
 def a3(kappa) -> np.ndarray:
     r"""Mean resultant length :math:`A_3(\kappa)=\coth\kappa-1/\kappa` of a vMF on :math:`S^2` (series for κ < 1e-3)."""
-    k = np.asarray(kappa, float)
-    if np.any(k < 0):
-        raise ValueError("kappa must be >= 0")
+    k = _kappa_array(kappa)
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         big = 1.0 / np.tanh(k) - 1.0 / k
-    series = k / 3.0 - k**3 / 45.0 + 2.0 * k**5 / 945.0
+    ks = np.minimum(k, _SMALL)  # the series only where it is used (no overflow)
+    series = ks / 3.0 - ks**3 / 45.0 + 2.0 * ks**5 / 945.0
     return np.where(k < _SMALL, series, big)
 
 
 def _a3_prime(k):
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         big = 1.0 / k**2 - 1.0 / np.sinh(k) ** 2
-    series = 1.0 / 3.0 - k**2 / 15.0 + 2.0 * k**4 / 189.0
+    ks = np.minimum(k, _SMALL)
+    series = 1.0 / 3.0 - ks**2 / 15.0 + 2.0 * ks**4 / 189.0
     return np.where(k < _SMALL, series, big)
 
 
@@ -122,8 +157,11 @@ def a3_inverse(rbar, *, tol: float = 1e-13, max_iter: int = 100) -> np.ndarray:
     current bracket are replaced by bisection (in log κ above 1).
     """
     r = np.asarray(rbar, float)
-    if np.any(~np.isfinite(r)) or np.any(r < 0) or np.any(r > 1):
-        raise ValueError("rbar must lie in [0, 1]")
+    bad = ~np.isfinite(r) | (r < 0) | (r > 1)
+    if np.any(bad):
+        raise ValueError(f"rbar must lie in [0, 1], got {r[bad].ravel()[0]!r}")
+    tol = _validate.positive(tol, "tol")
+    max_iter = _validate.integer(max_iter, "max_iter", minimum=1)
     scalar = r.ndim == 0
     r = np.atleast_1d(r).astype(float)
     out = np.zeros_like(r)
@@ -160,16 +198,23 @@ def a3_inverse(rbar, *, tol: float = 1e-13, max_iter: int = 100) -> np.ndarray:
 # ---------------------------------------------------------------------------
 
 
-def _weights(w, n: int) -> np.ndarray | None:
+def _weights(w, n: int, name: str = "weights") -> np.ndarray | None:
     if w is None:
         return None
-    w = np.asarray(w, float)
+    try:
+        w = np.asarray(w, float)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be numeric, got {w!r}") from None
     if w.shape != (n,):
-        raise ValueError(f"weights must have shape ({n},), got {w.shape}")
-    if np.any(~np.isfinite(w)) or np.any(w < 0):
-        raise ValueError("weights must be finite and >= 0")
+        raise ValueError(f"{name} must have shape ({n},), got {w.shape}")
+    bad = ~np.isfinite(w) | (w < 0)
+    if np.any(bad):
+        raise ValueError(
+            f"{name} must be finite and >= 0, got {int(bad.sum())} bad values "
+            f"(first: {w[np.argmax(bad)]!r})"
+        )
     if w.sum() <= 0:
-        raise ValueError("weights sum to zero")
+        raise ValueError(f"{name} sum to zero")
     return w
 
 
@@ -191,7 +236,15 @@ def vmf_fit(x, weights=None) -> VMFFit:
     Raises
     ------
     ValueError
-        When the resultant vanishes (no preferred direction).
+        When the resultant vanishes (no preferred direction, e.g. antipodal pairs:
+        :math:`\bar R = 0`, so μ is undefined), and for zero vectors or bad weights.
+
+    Warns
+    -----
+    RuntimeWarning
+        When all samples (with non-zero weight) are identical — a single sample
+        included: :math:`\bar R = 1` and the MLE :math:`\hat\kappa` is ∞ (returned as
+        ``inf``; μ is then the common direction).
     """
     x = as_unit_vectors(x, "x")
     w = _weights(weights, x.shape[0])
@@ -199,24 +252,53 @@ def vmf_fit(x, weights=None) -> VMFFit:
     n = float(x.shape[0] if w is None else w.sum())
     rn = float(np.linalg.norm(s))
     if rn <= 1e-12 * n:
-        raise ValueError("the resultant vector is zero: no mean direction")
+        raise ValueError(
+            f"x: the resultant vector of the {x.shape[0]} directions is zero "
+            f"(|S| = {rn:.3g}): no mean direction (e.g. antipodal pairs)"
+        )
     rbar = min(rn / n, 1.0)
-    return VMFFit(s / rn, float(a3_inverse(rbar)), rbar, n)
+    kappa = float(a3_inverse(rbar))
+    if np.isinf(kappa):
+        what = (
+            "x holds a single direction"
+            if x.shape[0] == 1
+            else f"all {x.shape[0]} directions in x are identical"
+        )
+        warnings.warn(
+            f"vmf_fit: {what} (mean resultant length 1): the concentration "
+            "estimate kappa is infinite",
+            RuntimeWarning,
+            stacklevel=2,
+        )
+    return VMFFit(s / rn, kappa, rbar, n)
 
 
 def vmf_logpdf(x, mu, kappa: float) -> np.ndarray:
-    r"""log of Eq. 14a, evaluated stably as :math:`\log\kappa-\log(2\pi(1-e^{-2\kappa}))+\kappa(\mu\cdot x-1)`."""
-    x = np.asarray(x, float)
-    mu = np.asarray(mu, float) / np.linalg.norm(mu)
+    r"""log of Eq. 14a, evaluated stably as :math:`\log\kappa-\log(2\pi(1-e^{-2\kappa}))+\kappa(\mu\cdot x-1)`.
+
+    ``x`` (..., 3) are directions (normalised here; NaN rows give NaN, zero rows are an
+    error), ``mu`` a non-zero 3-vector and ``kappa`` ≥ 0 finite. κ → 0 tends to the
+    uniform density :math:`1/(4\pi)` smoothly (series below κ = 10⁻⁸); large κ (10⁶)
+    neither overflows nor loses the normalisation.
+    """
+    x = _validate.vectors(x, "x", width=3, ndim=None, allow_nan=True)
+    nx = np.linalg.norm(x, axis=-1, keepdims=True)
+    if np.any(nx == 0):
+        raise ValueError(
+            f"x contains {int((nx == 0).sum())} zero vectors (no direction)"
+        )
+    x = x / nx
+    mu = _direction(mu, "mu")
     kappa = _validate.nonnegative(kappa, "kappa")
     if kappa == 0:
-        return np.full(x.shape[:-1], -np.log(4 * np.pi))
-    return (
-        np.log(kappa)
-        - np.log(2 * np.pi)
-        - np.log1p(-np.exp(-2 * kappa))
-        + kappa * (x @ mu - 1.0)
-    )
+        return np.where(np.isnan(x[..., 0]), np.nan, -np.log(4 * np.pi))
+    if (
+        kappa < 1e-8
+    ):  # log(kappa / (1 - e^{-2 kappa})) = -log 2 + kappa - kappa^2/6 + ...
+        log_c = -np.log(4 * np.pi) + kappa - kappa * kappa / 6.0
+    else:
+        log_c = np.log(kappa) - np.log(2 * np.pi) - np.log(-np.expm1(-2 * kappa))
+    return log_c + kappa * (x @ mu - 1.0)
 
 
 def vmf_pdf(x, mu, kappa: float) -> np.ndarray:
@@ -236,16 +318,21 @@ def _frame(mu) -> np.ndarray:
 def vmf_sample(mu, kappa: float, n: int, rng=None) -> np.ndarray:
     r"""``n`` independent draws from vMF(μ, κ) on :math:`S^2` (exact inverse-CDF of Wood 1994).
 
-    :math:`w = \mu\cdot x = 1 + \log\big(u + (1-u)e^{-2\kappa}\big)/\kappa`, longitude uniform.
+    :math:`w = \mu\cdot x = 1 + \log\big(u + (1-u)e^{-2\kappa}\big)/\kappa`, longitude uniform,
+    evaluated as :math:`1 + \operatorname{log1p}\big((1-u)\operatorname{expm1}(-2\kappa)\big)/\kappa`
+    so that small κ (10⁻⁸, 10⁻³⁰⁰) gives the uniform distribution (w = 2u − 1) to
+    rounding and large κ (10⁶) neither overflows nor collapses; κ = 0 is uniform.
     """
+    mu = _direction(mu, "mu")
     kappa = _validate.nonnegative(kappa, "kappa")
     n = _validate.integer(n, "n", minimum=0)
     rng = np.random.default_rng(rng)
     u = rng.random(int(n))
-    if kappa == 0:
+    if kappa < 1e-12:  # uniform to O(kappa): E[w] = A3(kappa) ~ kappa / 3
         w = 2 * u - 1
     else:
-        w = 1.0 + np.log(u + (1 - u) * np.exp(-2 * kappa)) / kappa
+        with np.errstate(divide="ignore"):
+            w = 1.0 + np.log1p((1 - u) * np.expm1(-2 * kappa)) / kappa
     w = np.clip(w, -1, 1)
     phi = rng.uniform(0, 2 * np.pi, int(n))
     s = np.sqrt(1 - w * w)
@@ -258,11 +345,19 @@ def vmf_cap_area(kappa, level) -> np.ndarray:
 
     :math:`P(\mu\cdot x \ge t)=\frac{1-e^{-\kappa(1-t)}}{1-e^{-2\kappa}}`, and the cap
     area is :math:`2\pi(1-t) = -\frac{2\pi}{\kappa}\log\big(1-p(1-e^{-2\kappa})\big)`.
+    κ = 0 (and its limit) gives the uniform :math:`4\pi p`, κ = ∞ (a point mass) 0.
     """
-    k, p = np.asarray(kappa, float), np.asarray(level, float)
-    if np.any(k <= 0) or np.any((p <= 0) | (p >= 1)):
-        raise ValueError("kappa must be > 0 and level in (0, 1)")
-    return -2 * np.pi * np.log1p(-p * (-np.expm1(-2 * k))) / k
+    k = _kappa_array(kappa)
+    p = np.asarray(level, float)
+    bad = ~np.isfinite(p) | (p <= 0) | (p >= 1)
+    if np.any(bad):
+        raise ValueError(f"level must be in (0, 1), got {p[bad].ravel()[0]!r}")
+    k, p = np.broadcast_arrays(k, p)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        area = -2 * np.pi * np.log1p(-p * (-np.expm1(-2 * k))) / k
+    small = k < 1e-8  # -log1p(-2kp)/k -> 2p (1 + k p)
+    area = np.where(small, 4 * np.pi * p * (1 + k * (p - 1)), area)
+    return area[()] if area.ndim == 0 else area
 
 
 def vmf_bootstrap(
@@ -372,8 +467,10 @@ def mean_tilt_point(tmap, mesh: SphereMesh | None = None) -> VMFFit:
         mesh = sphere_mesh() if mesh is None else mesh
         c, w = mesh.centroids, np.asarray(tmap, float)
         if w.shape != (mesh.n_faces,):
-            raise ValueError(f"map has shape {w.shape}, mesh has {mesh.n_faces} facets")
-    return vmf_fit(c, w)
+            raise ValueError(
+                f"tmap has shape {w.shape}, mesh has {mesh.n_faces} facets"
+            )
+    return vmf_fit(c, _weights(w, c.shape[0], "tmap"))
 
 
 def sagittal_angle(mu, lesion_side: str = "left") -> np.ndarray:
@@ -390,23 +487,24 @@ def sagittal_angle(mu, lesion_side: str = "left") -> np.ndarray:
     so α > 0 means the head is tilted toward the lesioned side. :math:`|\alpha|` is
     Fayat et al.'s "angular distance to the sagittal plane" (Fig. 4c).
     """
-    mu = np.asarray(mu, float)
-    if mu.shape[-1] != 3:
-        raise ValueError("mu must have a last axis of length 3")
+    mu = _validate.vectors(mu, "mu", width=3, ndim=None, allow_nan=True)
     s = {"left": 1.0, "right": -1.0}.get(lesion_side)
     if s is None:
         raise ValueError(f"lesion_side must be 'left' or 'right', got {lesion_side!r}")
-    mu = mu / np.linalg.norm(mu, axis=-1, keepdims=True)
+    n = np.linalg.norm(mu, axis=-1, keepdims=True)
+    if np.any(n == 0):
+        raise ValueError("mu contains zero vectors (no direction)")
+    mu = mu / n
     return np.arcsin(np.clip(-s * mu[..., 1], -1, 1))
 
 
 def rotation_to_pole(point) -> np.ndarray:
     r"""The minimal rotation matrix R (3×3) with :math:`R\,p = e_z` (about the axis :math:`p\times e_z`).
 
-    Rodrigues' formula; for :math:`p=-e_z` a half-turn about x.
+    Rodrigues' formula; for :math:`p=-e_z` a half-turn about x. ``point`` must be a
+    finite non-zero 3-vector.
     """
-    p = np.asarray(point, float).reshape(3)
-    p = p / np.linalg.norm(p)
+    p = _direction(point, "point")
     ez = np.array([0.0, 0.0, 1.0])
     c = float(p @ ez)
     if c < -1 + 1e-15:
@@ -424,16 +522,15 @@ def rotate_to_pole(vectors, baseline):
     (time, axis) series / a Recording (its ``gravity``), which gives a DataArray back
     with the same coordinates and attributes.
     """
+    R = rotation_to_pole(_direction(baseline, "baseline"))
     if isinstance(vectors, (xr.DataArray, xr.Dataset)):
         sig = _read(vectors, allow_nan=True)
-        out = sig.values @ rotation_to_pole(baseline).T
+        out = sig.values @ R.T
         attrs = {"units": "1", "long_name": "direction, baseline at the pole"}
         if "method" in sig.attrs:
             attrs["method"] = sig.attrs["method"]
         return _validate.labelled(
             out, sig, "rotated", dims=("time", "axis"), attrs=attrs
         )
-    v = np.asarray(vectors, float)
-    if v.shape[-1] != 3:
-        raise ValueError("vectors must have a last axis of length 3")
-    return v @ rotation_to_pole(baseline).T
+    v = _validate.vectors(vectors, "vectors", width=3, ndim=None, allow_nan=True)
+    return v @ R.T

@@ -79,6 +79,7 @@ from statsmodels.stats.nonparametric import rank_compare_2indep
 
 from .. import _validate
 from .nonparametric import (
+    ZERO_METHODS,
     _alternative,
     _mwu_counts_noties,
     _sample,
@@ -275,6 +276,10 @@ def paired_rank_biserial(x, y=None, *, zero_method: str = "wilcox") -> float:
     ``RBC`` for ``alternative="greater"`` or ``"two-sided"`` (pingouin flips its sign
     for ``"less"``). NaN when every difference is zero.
     """
+    if zero_method not in ZERO_METHODS:
+        raise ValueError(
+            f"zero_method must be one of {ZERO_METHODS}, got {zero_method!r}"
+        )
     d = _sample(x, "x")
     if y is not None:
         d = d - _sample(y, "y")

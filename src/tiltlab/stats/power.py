@@ -99,7 +99,9 @@ def normal_shift(shift: float, *, sd: float = 1.0) -> Simulator:
 
 def normal_shift_superiority(shift: float, sd: float = 1.0) -> float:
     r""":math:`P(X > Y) = \Phi(\delta/(\sigma\sqrt2))` for two normal groups."""
-    return float(_st.norm.cdf(_validate.finite(shift, "shift") / (sd * math.sqrt(2))))
+    shift = _validate.finite(shift, "shift")
+    sd = _validate.positive(sd, "sd")
+    return float(_st.norm.cdf(shift / (sd * math.sqrt(2))))
 
 
 def noether_n_per_group(
@@ -128,7 +130,8 @@ def noether_n_per_group(
     )
     if p == 0.5:
         raise ValueError(
-            "p_superiority must differ from 1/2 (no effect, no sample size)"
+            f"p_superiority must differ from 1/2 (no effect, no sample size), got "
+            f"{p_superiority!r}"
         )
     a = _validate.fraction(alpha, "alpha", open_low=True, open_high=True)
     pw = _validate.fraction(power, "power", open_low=True, open_high=True)

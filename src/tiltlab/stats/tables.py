@@ -466,12 +466,12 @@ def format_table(
     -------
     pandas.DataFrame or pandas.io.formats.style.Styler
     """
-    for c in ("comparison", "timepoint", value):
-        if c not in tidy.columns:
-            raise ValueError(f"tidy has no column {value if c == value else c!r}")
     if output not in ("text", "styler", "frame"):
         raise ValueError(f"output must be 'text', 'styler' or 'frame', got {output!r}")
     decimals = _validate.integer(decimals, "decimals", minimum=0)
+    for c in ("comparison", "timepoint", value):
+        if c not in tidy.columns:
+            raise ValueError(f"tidy has no column {value if c == value else c!r}")
     rows = list(dict.fromkeys(tidy["comparison"]))
     cols = list(dict.fromkeys(tidy["timepoint"]))
     grid = tidy.pivot_table(

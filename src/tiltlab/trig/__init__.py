@@ -49,7 +49,10 @@ Modules
 * :mod:`~tiltlab.trig.oscillations` — crossing times and oscillation statistics (§9).
 
 Benhamou's frames, rotation matrices and sign conventions live in
-:mod:`tiltlab.frames` and are re-exported here. Static acceleration and DBA (§2, §9)
+:mod:`tiltlab.frames` and are re-exported here; :func:`wrap_angle`,
+:func:`angles_from_quaternion` and :func:`angles_from_matrix` are the labelled,
+checked versions of :mod:`~tiltlab.trig.angles` (DataArrays in, DataArrays out;
+non-unit quaternions normalised with a warning; reflections refused). Static acceleration and DBA (§2, §9)
 are in :mod:`tiltlab.behavior`; the four-point magnetometer calibration (Eq. 4) in
 :mod:`tiltlab.calibration`.
 
@@ -59,7 +62,17 @@ Functions that take sensor samples (``acc``, ``mag``, ``gyr`` or a 1-D signal) a
 a Recording, a labelled DataArray or a plain array; ``fs`` and ``units`` are read from
 the attributes (a missing or contradictory one is a
 :class:`~tiltlab._validate.RecordingError` naming it) and labelled input gives labelled
-output (DataArrays with ``time``, ``fs``, ``units``).
+output (DataArrays with ``time``, ``fs``, ``units``). Per-sample functions of angles
+(:func:`arc`, :func:`azimuth_change`, :func:`simultaneous_rotations`, ...) accept
+labelled angles too (``units`` "rad" or "deg"; several labelled arguments must share
+their ``time`` coordinate) and then return DataArrays with that coordinate.
+
+Undefined quantities
+--------------------
+Following :mod:`tiltlab._validate`'s policy, quantities that are undefined for some
+samples are NaN with a :class:`RuntimeWarning`: the azimuth (heading) where the
+magnetic field is zero or parallel to the acceleration, and every posture angle where
+the acceleration (or, for :func:`magnetic_posture`, the field) is zero.
 
 Corrections to the seed text
 ----------------------------
@@ -97,8 +110,6 @@ from ..frames import (
     Convention,
     Orientation,
     acc_from_angles,
-    angles_from_matrix,
-    angles_from_quaternion,
     angles_to_matrix,
     angles_to_quaternion,
     body_rates_to_gyro,
@@ -113,9 +124,9 @@ from ..frames import (
     spherical_coords,
     to_benhamou_acc,
     unit_vector,
-    wrap_angle,
 )
 from ._types import Arc, OscillationStats, Posture, Rotations
+from .angles import angles_from_matrix, angles_from_quaternion, wrap_angle
 from .arcs import *  # noqa: F401,F403
 from .arcs import __all__ as _arcs
 from .deadreckoning import *  # noqa: F401,F403

@@ -2,7 +2,8 @@ r"""Changes of heading along orthodromic arcs (Benhamou 2023 §5, Eqs. 6–9).
 
 Angles in radians; azimuth θ counter-clockwise from East, elevation φ above the
 horizon. These functions take angles (scalars or arrays that broadcast), not sensor
-samples.
+samples; labelled angles (DataArrays, e.g. from :func:`tiltlab.trig.heading`) give
+DataArrays with their ``time`` coordinate.
 """
 
 from __future__ import annotations
@@ -10,6 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..frames import _clip1, acc_from_angles, unit_vector, wrap_angle
+from ._common import angle_function
 from ._types import Arc
 
 __all__ = [
@@ -22,6 +24,7 @@ __all__ = [
 ]
 
 
+@angle_function(())
 def arc(az0, el0, az1, el1) -> Arc:
     r"""Orthodromic arc between headings (θ0, φ0) → (θ1, φ1): size and inclinations, Eq. 7.
 
@@ -46,11 +49,13 @@ def _incl(az0, el0, az1, el1, w, q):
     return np.arctan2(num, den)
 
 
+@angle_function("inclination")
 def arc_inclination(az0, el0, az1, el1, q) -> np.ndarray:
     """Local inclination δ̃(q), q ∈ [0, 1], of the arc (θ0, φ0) → (θ1, φ1), Eq. 7b."""
     return _incl(az0, el0, az1, el1, arc(az0, el0, az1, el1).size, q)
 
 
+@angle_function(("azimuth", "elevation"))
 def interpolate_heading(
     az0, el0, initial_inclination, size, q
 ) -> tuple[np.ndarray, np.ndarray]:
@@ -76,6 +81,7 @@ def interpolate_heading(
     return wrap_angle(th), ph
 
 
+@angle_function(("apex_elevation", "apex_azimuth"))
 def great_circle_apex(az, el, inclination) -> tuple[np.ndarray, np.ndarray]:
     r"""Apex (highest point) of the great circle through heading (θ, φ) with local inclination δ (§5).
 
@@ -97,6 +103,7 @@ def great_circle_apex(az, el, inclination) -> tuple[np.ndarray, np.ndarray]:
     return ph, wrap_angle(th)
 
 
+@angle_function("bank")
 def interpolate_bank(az0, el0, bank0, az1, el1, bank1, q) -> np.ndarray:
     r"""Bank angle at fraction q of a step, Eq. 8 (constant roll speed).
 
@@ -112,6 +119,7 @@ def interpolate_bank(az0, el0, bank0, az1, el1, bank1, q) -> np.ndarray:
     )
 
 
+@angle_function("posture_change")
 def posture_change(el0, bank0, el1, bank1) -> np.ndarray:
     r"""Size :math:`\bar\omega` of a change of posture, Eq. 9: :math:`\cos\bar\omega=[\lambda_0\bullet\phi_0]\cdot[\lambda_1\bullet\phi_1]`.
 

@@ -7,6 +7,8 @@ demonstrations are in :func:`tiltlab.simulate.simulate_track`.
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 
 from .. import _validate as _v
@@ -42,12 +44,26 @@ def lonlat_to_local(
 def local_to_lonlat(
     x, y, lon0, lat0, lat1, *, radius: float = EARTH_RADIUS
 ) -> tuple[np.ndarray, np.ndarray]:
-    r"""Inverse of :func:`lonlat_to_local` for in-between points: :math:`\xi=\Xi_0+x/(R\cos((\Psi_0+\Psi_1)/2))`, :math:`\psi=\Psi_0+y/R`."""
+    r"""Inverse of :func:`lonlat_to_local` for in-between points: :math:`\xi=\Xi_0+x/(R\cos((\Psi_0+\Psi_1)/2))`, :math:`\psi=\Psi_0+y/R`.
+
+    A step centred on a pole (cos of the mean latitude 0) has no longitude: NaN, with a
+    :class:`RuntimeWarning`.
+    """
     radius = _v.positive(radius, "radius")
     c = np.cos((np.asarray(lat0, float) + np.asarray(lat1, float)) / 2)
-    return wrap_angle(
-        np.asarray(lon0, float) + np.asarray(x, float) / (radius * c)
-    ), np.asarray(lat0, float) + np.asarray(y, float) / radius
+    pole = np.abs(c) < 1e-12
+    if np.any(pole):
+        warnings.warn(
+            f"local_to_lonlat: {int(np.sum(pole))} step(s) centred on a pole, where "
+            "the longitude is undefined; set to NaN",
+            RuntimeWarning,
+            stacklevel=2,
+        )
+    with np.errstate(divide="ignore", invalid="ignore"):
+        lon = np.asarray(lon0, float) + np.asarray(x, float) / (radius * c)
+    return wrap_angle(np.where(pole, np.nan, lon)), np.asarray(
+        lat0, float
+    ) + np.asarray(y, float) / radius
 
 
 def velocity_components(speed, az, el=None) -> np.ndarray:
@@ -56,11 +72,22 @@ def velocity_components(speed, az, el=None) -> np.ndarray:
     return np.asarray(speed, float)[..., None] * unit_vector(az, el)
 
 
+def _steps(**named) -> list[np.ndarray]:
+    """Per-step inputs as finite 1-D arrays of one length; NaN/inf or a mismatch is an
+    error naming the argument (a NaN step would corrupt its whole anchor interval)."""
+    out = [_v.vectors(a, k, width=None, ndim=1) for k, a in named.items()]
+    n = out[0].shape[0]
+    for k, a in zip(named, out, strict=True):
+        if a.shape[0] != n:
+            raise ValueError(
+                f"{k} must have one value per step ({n}, like speed), got {a.shape[0]}"
+            )
+    return out
+
+
 def _check_anchors(anchors, anchor_steps, n, dim):
-    X = np.asarray(anchors, float)
+    X = _v.vectors(anchors, "anchors", width=dim, ndim=2)
     idx = np.asarray(anchor_steps)
-    if X.ndim != 2 or X.shape[1] != dim:
-        raise ValueError(f"anchors must have shape (M, {dim}), got {X.shape}")
     if idx.shape != (X.shape[0],) or X.shape[0] < 2:
         raise ValueError(
             "anchor_steps must have one index per anchor and at least two anchors"
@@ -124,7 +151,7 @@ def dead_reckon(
     interval is filled by constant-velocity straight-line interpolation; if L = 0,
     the reconstructed bout collapses on the anchor (scale 0).
     """
-    v = velocity_components(speed, az, el)
+    v = velocity_components(*_steps(speed=speed, az=az, el=el))
     n = v.shape[0]
     X, idx = _check_anchors(anchors, anchor_steps, n, 3)
     dX = np.diff(X, axis=0)
@@ -133,7 +160,7 @@ def dead_reckon(
         if dt_s is None:
             raise ValueError("dt_s (step duration, s) is required with current")
         dt_s = _v.positive(dt_s, "dt_s")
-        cur = np.asarray(current, float)
+        cur = _v.vectors(current, "current", width=None, ndim=None)
         if cur.shape != (X.shape[0] - 1, 2):
             raise ValueError(
                 f"current must have shape ({X.shape[0] - 1}, 2), got {cur.shape}"
@@ -184,7 +211,7 @@ def dead_reckon_2d(speed, az, anchors, anchor_steps) -> np.ndarray:
     Equal to :func:`dead_reckon` with zero elevations. ``anchors`` shape (M, 2);
     returns (N+1, 2). Same fallback for a null proxy sum.
     """
-    v = velocity_components(speed, az)[:, :2]
+    v = velocity_components(*_steps(speed=speed, az=az))[:, :2]
     n = v.shape[0]
     X, idx = _check_anchors(anchors, anchor_steps, n, 2)
     dX = np.diff(X, axis=0)

@@ -11,6 +11,8 @@ labelled output. Magnetometer calibration (Eq. 4) lives in
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 
 from .. import _validate as _v
@@ -24,7 +26,7 @@ from ..frames import (
     unit_vector,
     wrap_angle,
 )
-from ._common import first_labelled, label, pair, read
+from ._common import angle_function, first_labelled, label, pair, read
 
 __all__ = [
     "mounting_azimuth_offset",
@@ -40,8 +42,26 @@ def _declination(declination) -> np.ndarray:
     return _v.vectors(declination, "declination", width=None, ndim=None)
 
 
-def _azimuth(A, M, declination, singular_tol: float) -> np.ndarray:
-    """Eq. 5 on arrays (A in Benhamou's sign)."""
+def _undefined(A, M, singular_tol: float) -> np.ndarray:
+    """Samples whose azimuth is undefined: zero acceleration or field, or a field
+    parallel to the acceleration (‖A×M‖ ≤ singular_tol·‖A‖‖M‖: no horizontal field)."""
+    A, M = np.broadcast_arrays(A, M)
+    na = np.linalg.norm(A, axis=-1)
+    nm = np.linalg.norm(M, axis=-1)
+    cross = np.linalg.norm(np.cross(A, M), axis=-1)
+    return (na == 0) | (nm == 0) | (cross <= singular_tol * na * nm)
+
+
+def _warn_undefined(where: str, bad: np.ndarray, total: int, why: str) -> None:
+    warnings.warn(
+        f"{where}: {int(np.sum(bad))} of {total} samples set to NaN: {why}",
+        RuntimeWarning,
+        stacklevel=4,
+    )
+
+
+def _azimuth(A, M, declination, singular_tol: float, where: str) -> np.ndarray:
+    """Eq. 5 on arrays (A in Benhamou's sign); NaN (with a warning) where undefined."""
     A, M = np.broadcast_arrays(A, M)
     AU, AV, AW = A[..., 0], A[..., 1], A[..., 2]
     MU, MV, MW = M[..., 0], M[..., 1], M[..., 2]
@@ -52,12 +72,30 @@ def _azimuth(A, M, declination, singular_tol: float) -> np.ndarray:
     sg = np.where(AU >= 0, 1.0, -1.0)
     pseudo = np.arctan2(MV, -sg * MW) - np.pi / 2
     th = np.where(sing, pseudo, th)
+    bad = _undefined(A, M, singular_tol)
+    if np.any(bad):
+        _warn_undefined(
+            where,
+            bad,
+            bad.size,
+            "the azimuth is undefined where mag (or acc) is a zero vector or mag is "
+            "parallel to acc (no horizontal field, e.g. at a magnetic pole); a zero "
+            "acc also leaves elevation and bank undefined",
+        )
+        th = np.where(bad, np.nan, th)
     return wrap_angle(th - declination)
 
 
 def _read_pair(acc, mag):
     sa = read(acc, "acc")
     sm = read(pair(acc, mag), "mag")
+    try:
+        np.broadcast_shapes(sa.values.shape, sm.values.shape)
+    except ValueError:
+        raise ValueError(
+            f"acc and mag must have the same number of samples (or broadcast), got "
+            f"shapes {sa.values.shape} and {sm.values.shape}"
+        ) from None
     return sa, sm
 
 
@@ -103,6 +141,10 @@ def azimuth(
     the pseudo-azimuth θ = θ' − π/2 with θ' = atan2(M_V, −sgn(A_U) M_W), the
     direction of the sway axis (§3), consistent with pseudo-bank λ = 0.
 
+    Undefined azimuth — a zero field or acceleration, or a field parallel to the
+    acceleration (:math:`\|\mathbf A\times\mathbf M\| \le` ``singular_tol``
+    ·‖𝐀‖‖𝐌‖, e.g. at a magnetic pole): NaN with a :class:`RuntimeWarning`.
+
     Parameters
     ----------
     acc : xarray.Dataset, xarray.DataArray or array_like (..., 3)
@@ -114,7 +156,9 @@ def azimuth(
     singular_tol = _v.positive(singular_tol, "singular_tol")
     decl = _declination(declination)
     sa, sm = _read_pair(acc, mag)
-    th = _azimuth(_as_benhamou(sa.values, convention), sm.values, decl, singular_tol)
+    th = _azimuth(
+        _as_benhamou(sa.values, convention), sm.values, decl, singular_tol, "azimuth"
+    )
     return label(th, first_labelled(sa, sm), "azimuth", "rad")
 
 
@@ -144,17 +188,21 @@ def heading(
 
     Inputs as for :func:`azimuth` (``heading(rec)`` reads a Recording's ``acc`` and
     ``mag``). Returns an :class:`~tiltlab.frames.Orientation` in radians (DataArrays
-    for labelled input).
+    for labelled input). Undefined angles are NaN with a :class:`RuntimeWarning`: the
+    azimuth as in :func:`azimuth`, and all three where the acceleration is zero.
     """
     singular_tol = _v.positive(singular_tol, "singular_tol")
     decl = _declination(declination)
     sa, sm = _read_pair(acc, mag)
     A = _as_benhamou(sa.values, convention)
-    th = _azimuth(A, sm.values, decl, singular_tol)
+    th = _azimuth(A, sm.values, decl, singular_tol, "heading")
     el, bk = _elev_bank(A)
     sing = np.hypot(A[..., 1], A[..., 2]) < singular_tol * np.linalg.norm(A, axis=-1)
     el = np.where(sing, np.where(A[..., 0] >= 0, -np.pi / 2, np.pi / 2), el)
     bk = np.where(sing, 0.0, bk)
+    zero = np.linalg.norm(A, axis=-1) == 0  # (already warned about by _azimuth)
+    el = np.where(zero, np.nan, el)
+    bk = np.where(zero, np.nan, bk)
     like = first_labelled(sa, sm)
     return Orientation(
         label(th, like, "azimuth", "rad"),
@@ -163,6 +211,7 @@ def heading(
     )
 
 
+@angle_function("azimuth")
 def body_azimuth_from_device(device_azimuth, elevation, bank, phi_star) -> np.ndarray:
     r"""§3 alternative to Eq. 5: :math:`\theta=\theta^d-\mathrm{atan2}(c_2,c_1)`,
     :math:`(c_1,c_2,c_3)^\top=R_2(\phi)R_1(\lambda)[0\bullet\phi^*]^\top`.
@@ -178,6 +227,7 @@ def body_azimuth_from_device(device_azimuth, elevation, bank, phi_star) -> np.nd
     )
 
 
+@angle_function("azimuth")
 def apply_declination(magnetic_azimuth, declination) -> np.ndarray:
     """True azimuth = magnetic azimuth − declination (rad, declination positive East),
     wrapped to (−π, π]."""

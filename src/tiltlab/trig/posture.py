@@ -7,11 +7,13 @@ output. Units do not matter (only directions do).
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 
 from .. import _validate as _v
 from ..frames import Convention, _as_benhamou, _clip1, _elev_bank, acc_from_angles
-from ._common import label, read
+from ._common import angle_function, label, read
 from ._types import Posture
 
 __all__ = [
@@ -38,7 +40,9 @@ def posture(acc, *, convention: Convention = "tiltlab") -> Posture:
     with Benhamou's sign 𝐀 (−𝐟 for tiltlab specific force). φ is evaluated in its
     atan form and ζ as atan2 (accurate near 0 and ±π/2). Singular cases: λ is
     undefined at φ = ±π/2 (returned as atan2(0, 0) = 0, the pseudo-bank of §3); χ is
-    undefined at ζ = 0 (returned as 0).
+    undefined at ζ = 0 (returned as 0). A zero acceleration (free fall, a dropped
+    sample written as 0) has no posture: all four angles are NaN, with a
+    :class:`RuntimeWarning`.
 
     Parameters
     ----------
@@ -58,6 +62,7 @@ def posture(acc, *, convention: Convention = "tiltlab") -> Posture:
     el, bk = _elev_bank(A)
     zeta = np.arctan2(np.hypot(A[..., 0], A[..., 1]), -A[..., 2])
     chi = np.arctan2(-A[..., 1], -A[..., 0])
+    el, bk, zeta, chi = _nan_where_zero(A, "posture", "acc", el, bk, zeta, chi)
     return Posture(
         label(el, s, "elevation", "rad"),
         label(bk, s, "bank", "rad"),
@@ -66,6 +71,21 @@ def posture(acc, *, convention: Convention = "tiltlab") -> Posture:
     )
 
 
+def _nan_where_zero(V, where: str, name: str, *angles):
+    """The angles, NaN (with a RuntimeWarning) where the vector ``V`` is zero."""
+    zero = np.all(V == 0, axis=-1)
+    if not np.any(zero):
+        return angles
+    warnings.warn(
+        f"{where}: {int(np.sum(zero))} of {zero.size} samples of {name} are zero "
+        "vectors, whose direction (hence every angle) is undefined; set to NaN",
+        RuntimeWarning,
+        stacklevel=3,
+    )
+    return tuple(np.where(zero, np.nan, a) for a in angles)
+
+
+@angle_function(("inclination", "orientation"))
 def inclination_from_angles(elevation, bank) -> tuple[np.ndarray, np.ndarray]:
     r"""(ζ, χ) from (φ, λ):
     :math:`[\chi\bullet(\pi/2-\zeta)] = (\sin\phi, \cos\phi\sin\lambda,
@@ -78,6 +98,7 @@ def inclination_from_angles(elevation, bank) -> tuple[np.ndarray, np.ndarray]:
     return zeta, np.arctan2(v[..., 1], v[..., 0])
 
 
+@angle_function(("elevation", "bank"))
 def angles_from_inclination(inclination, orientation) -> tuple[np.ndarray, np.ndarray]:
     r"""(φ, λ) from (ζ, χ): :math:`\phi=\sin^{-1}(\sin\zeta\cos\chi)`,
     :math:`\lambda=\mathrm{atan2}(\sin\zeta\sin\chi,\cos\zeta)`."""
@@ -88,6 +109,7 @@ def angles_from_inclination(inclination, orientation) -> tuple[np.ndarray, np.nd
     return elevation, np.arctan2(np.sin(z) * np.sin(c), np.cos(z))
 
 
+@angle_function("elevation", angles=("elevation",))
 def correct_tangential(elevation, tangential_acc, *, g: float = 9.81) -> np.ndarray:
     r"""Elevation corrected for a sustained forward acceleration h = Δv/Δt (§2):
     :math:`\phi - \tan^{-1}(h/g)`.
@@ -100,6 +122,7 @@ def correct_tangential(elevation, tangential_acc, *, g: float = 9.81) -> np.ndar
     )
 
 
+@angle_function("bank", angles=("bank",))
 def correct_centripetal(bank, speed, curvature, *, g: float = 9.81) -> np.ndarray:
     r"""Bank corrected for a sustained horizontal turn (§2):
     :math:`\lambda - \tan^{-1}(v^2\kappa/g)`.
@@ -119,10 +142,12 @@ def magnetic_posture(mag) -> tuple[np.ndarray, np.ndarray]:
 
     Insensitive to dynamic acceleration, but measured against the plane orthogonal
     to the (dipping) field, hence hard to interpret on its own. ``mag``: a Recording
-    (its ``mag``), a labelled DataArray or an array (..., 3).
+    (its ``mag``), a labelled DataArray or an array (..., 3). Zero field vectors give
+    NaN with a :class:`RuntimeWarning`.
     """
     s = read(mag, "mag")
     el, bk = _elev_bank(s.values)
+    el, bk = _nan_where_zero(s.values, "magnetic_posture", "mag", el, bk)
     return label(el, s, "magnetic_elevation", "rad"), label(
         bk, s, "magnetic_bank", "rad"
     )
@@ -139,12 +164,18 @@ def posture_from_magnetic_loop(
     :math:`\zeta=\cos^{-1}(|\Sigma M_W|/\|\Sigma\mathbf M\|)`,
     :math:`\phi=\sin^{-1}(-\mathrm{sgn}(I)\Sigma M_U/\|\Sigma\mathbf M\|)`,
     :math:`\lambda=\tan^{-1}(-\mathrm{sgn}(I)\Sigma M_V/|\Sigma M_W|)`.
-    Returns (ζ, φ, λ); valid for |λ| < π/2.
+    Returns (ζ, φ, λ); valid for |λ| < π/2. A zero sum (e.g. a field that cancels
+    over the loop) has no direction: an error naming ``mag_loop``.
     """
     inclination = _v.finite(inclination, "inclination")
     m = read(mag_loop, "mag_loop", var="mag", allow_nan=False).values
     s = m.reshape(-1, 3).sum(axis=0)
     n = np.linalg.norm(s)
+    if n == 0:
+        raise ValueError(
+            f"mag_loop: the {m.reshape(-1, 3).shape[0]} field vectors sum to zero; "
+            "the posture is undefined"
+        )
     sg = np.sign(inclination) if inclination != 0 else 1.0
     zeta = float(np.arctan2(np.hypot(s[0], s[1]), abs(s[2])))
     phi = float(np.arcsin(np.clip(-sg * s[0] / n, -1, 1)))

@@ -26,7 +26,7 @@ from ..frames import (
     unit_vector,
     wrap_angle,
 )
-from ._common import read, windowed
+from ._common import angle_function, read, windowed
 from ._types import Rotations
 from .arcs import arc, interpolate_heading
 
@@ -91,6 +91,7 @@ def body_rotations(
     )
 
 
+@angle_function(("yaw", "pitch"))
 def sequential_yaw_pitch(size, eta) -> tuple[np.ndarray, np.ndarray]:
     r"""Eq. 10: yaw then pitch decomposition of an arc of size ω at constant body-relative inclination η.
 
@@ -105,6 +106,7 @@ def sequential_yaw_pitch(size, eta) -> tuple[np.ndarray, np.ndarray]:
     )
 
 
+@angle_function(("size", "eta"))
 def sequential_arc_from_yaw_pitch(yaw, pitch) -> tuple[np.ndarray, np.ndarray]:
     r"""Inverse of Eq. 10: arc size ω and body-relative inclination η of sequential yaw α then pitch β.
 
@@ -118,6 +120,7 @@ def sequential_arc_from_yaw_pitch(yaw, pitch) -> tuple[np.ndarray, np.ndarray]:
     )
 
 
+@angle_function(("yaw", "pitch"))
 def heading_in_body_frame(az0, el0, bank0, az1, el1) -> tuple[np.ndarray, np.ndarray]:
     r"""§6: heading at step i in the body frame of step i−1: :math:`[\alpha\bullet\beta]^\top=R_1(-\lambda_0)R_2(-\phi_0)R_3(-\theta_0)[\theta_1\bullet\phi_1]^\top`.
 
@@ -128,6 +131,7 @@ def heading_in_body_frame(az0, el0, bank0, az1, el1) -> tuple[np.ndarray, np.nda
     return spherical_coords(v)
 
 
+@angle_function(())
 def simultaneous_rotations(size, eta_initial, eta_final) -> Rotations:
     r"""Eq. 11 (corrected): yaw, pitch and roll of simultaneous rotations producing an arc of size ω.
 
@@ -151,6 +155,7 @@ def simultaneous_rotations(size, eta_initial, eta_final) -> Rotations:
     return Rotations(np.cos(eb) * f, np.sin(eb) * f, rho)
 
 
+@angle_function(())
 def rotations_from_orientations(
     az0,
     el0,
@@ -173,6 +178,7 @@ def rotations_from_orientations(
     raise ValueError(f"method must be 'simultaneous' or 'sequential', got {method!r}")
 
 
+@angle_function(("size", "eta"))
 def arc_from_rotations(yaw, pitch, roll) -> tuple[np.ndarray, np.ndarray]:
     r"""Eq. 12: arc size and mean body-relative inclination from gyroscope rotations.
 
@@ -186,6 +192,7 @@ def arc_from_rotations(yaw, pitch, roll) -> tuple[np.ndarray, np.ndarray]:
     return np.hypot(al, be) / np.sinc(ro / (2 * np.pi)), np.arctan2(be, al)
 
 
+@angle_function("azimuth_change")
 def azimuth_change(el0, bank0, el1, bank1, yaw, pitch, roll) -> np.ndarray:
     r"""Eq. 13: change of azimuth over a step from postures and gyroscope rotations.
 
@@ -300,6 +307,7 @@ def step_body_rates(
     )
 
 
+@angle_function(())
 def head_relative_to_body(
     az_b, el_b, bank_b, az_h, el_h, bank_h, *, singular_tol: float = 1e-9
 ) -> Orientation:
@@ -329,6 +337,10 @@ def head_relative_to_body(
     return Orientation(th, ph, lam)
 
 
+@angle_function(
+    ("arc_to_passage", "fraction", "longitude", "latitude"),
+    units=("rad", "1", "rad", "rad"),
+)
 def cap_passage(
     xi_in, psi_in, xi_out, psi_out, xi_mu, psi_mu, radius
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -347,6 +359,10 @@ def cap_passage(
     :math:`\sin\psi_\mu\cos\psi_I-\sin\psi_I\cos\psi_\mu\cos(\xi_\mu-\xi_I)` (algebraically
     identical, finite at the poles). P from Eq. 6 with δ^i_IO and ω_IP.
     """
+    r = np.asarray(radius, float)
+    bad = ~np.isfinite(r) | (r <= 0) | (r >= np.pi / 2)
+    if np.any(bad):
+        raise ValueError(f"radius must be in (0, π/2) rad, got {r[bad].ravel()[0]!r}")
     a_io = arc(xi_in, psi_in, xi_out, psi_out)
     d = a_io.initial
     psi_in, psi_mu = np.asarray(psi_in, float), np.asarray(psi_mu, float)
