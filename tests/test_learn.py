@@ -262,6 +262,13 @@ def test_saved_model_round_trip_and_closed_loop_run(small_sequences, tmp_path):
         learn.learned_estimate(half, tmp_path / "m.pt")
 
 
+def test_sequence_refuses_time_gaps(data_mirror):
+    rec = datasets.load_broad_trial(1).isel(time=slice(0, 3000))
+    gap = rec.isel(time=np.r_[0:1000, 1300:3000])
+    with pytest.raises(Exception, match="gap"):
+        learn.sequence(gap)
+
+
 def test_sequence_needs_a_magnetometer(data_mirror):
     rec = datasets.load_broad_trial(1).isel(time=slice(0, 500)).drop_vars("mag")
     with pytest.raises(Exception, match="mag"):

@@ -7,6 +7,11 @@ rotate **sensor → world**, world z up. With a magnetometer ("9D") the world fr
 is ENU (x east, y magnetic north, z up); without one ("6D") the heading of the
 world frame is arbitrary (fixed by the initial orientation).
 
+Gaps and dropouts: :func:`estimate` refuses a Recording whose time axis has gaps or
+whose samples contain NaN runs (``gaps="raise"``, the default, with a message saying
+where), or estimates each contiguous segment separately from its own initial orientation
+(``gaps="segments"``: NaN in the gaps, the segments recorded in the output's attrs).
+
 Methods
 -------
 ``lowpass``

@@ -111,6 +111,14 @@ def sequence(
                 f"{name} has non-finite samples; the learned estimators need gap-free "
                 "inputs"
             )
+    time = inputs.like.time
+    if time is not None and time.shape == (inputs.acc.shape[0],):
+        segs = _v.segments(time, inputs.fs)
+        if len(segs) > 1:
+            raise _v.RecordingError(
+                "the learned estimators need a recording without time gaps: "
+                f"{_v.describe_gaps(time, inputs.fs, segs)} (split it first)"
+            )
     Q = quat.integrate_gyro(inputs.gyr, inputs.fs)
     dip = _still_dip(inputs.acc, inputs.mag, inputs.fs)
     q_vec = davenport(inputs.acc, inputs.mag, dip=dip)
