@@ -87,21 +87,6 @@ def read_angles(a: xr.DataArray, name: str, *, angle: bool = True):
     return values, da
 
 
-def _check_time(das: dict[str, xr.DataArray]) -> None:
-    ref = None
-    for name, da in das.items():
-        if "time" not in da.coords or da["time"].ndim != 1:
-            continue
-        t = np.asarray(da["time"].values)
-        if ref is None:
-            ref = (name, t)
-        elif t.shape == ref[1].shape and not np.array_equal(t, ref[1]):
-            raise _v.RecordingError(
-                f"{name} and {ref[0]} have different time coordinates; "
-                "align them first (e.g. xarray.align or .interp)"
-            )
-
-
 def label_like(values, da: xr.DataArray, name: str, units: str | None, attrs=None):
     """``values`` as a DataArray labelled like ``da`` (its dims and coordinates when the
     shapes agree, else its ``time`` coordinate), with ``fs`` (and ``method``) kept."""
@@ -134,6 +119,10 @@ def angle_function(names, *, units="rad", angles=None):
     result; a NamedTuple's own field names win). ``units``: the output units (one
     string, or one per output). ``angles``: the parameters that are angles (their
     ``units`` are checked and degrees converted); default all of them.
+
+    Labelled arguments need not share a time axis (``azimuth_change`` takes two
+    orientations at consecutive times); they must have matching lengths, and the output
+    carries the first labelled argument's ``time``.
     """
 
     def deco(f):
@@ -149,7 +138,6 @@ def angle_function(names, *, units="rad", angles=None):
                 if isinstance(v, xr.DataArray):
                     is_angle = angles is None or k in angles
                     bound.arguments[k], das[k] = read_angles(v, k, angle=is_angle)
-            _check_time(das)
             try:
                 np.broadcast_shapes(*(np.shape(bound.arguments[k]) for k in das))
             except ValueError:
