@@ -371,7 +371,7 @@ def compare(
     import concurrent.futures as cf
     import multiprocessing as mp
 
-    from tqdm.auto import tqdm
+    from tqdm import tqdm
 
     folder = Path(folder)
     check_files(folder)

@@ -15,8 +15,8 @@ so the choices below are ours and stated):
   the bias from the gyro-integrated quaternion; we read this as a residual output,
   :math:`q_t = (q_{\omega,t} + \delta) / \lVert\cdot\rVert` with :math:`\delta` the
   output layer's four numbers, initialised at zero so that training starts from pure
-  integration. (A network asked for the absolute quaternion learns far more slowly and,
-  run in closed loop, drifts.)
+  integration. (In our development runs a network asked for the absolute quaternion
+  learned far more slowly and, run in closed loop, drifted.)
 
 The **learned-gain variant** (Eq. 2, proposed but not evaluated in the paper) has the
 same body but a single output :math:`\alpha = (1 + \tanh(\cdot))/2 \in (0, 1)` and
