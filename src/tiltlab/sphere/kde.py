@@ -75,7 +75,7 @@ from numba import njit, prange
 
 from .. import _validate
 from .mesh import _series, as_unit_vectors, to_lonlat
-from .vmf import _frame, angle, vmf_fit
+from .vmf import _direction, _frame, angle, vmf_fit
 
 __all__ = [
     "EqualAreaGrid",
@@ -196,22 +196,6 @@ def equal_area_grid(
         R = np.column_stack([m, np.cross(p, m), p])
     R.flags.writeable = False
     return EqualAreaGrid(n_lon, n_lat, R)
-
-
-def _direction(v, name: str) -> np.ndarray:
-    """One direction (3,) as a unit vector; a zero or non-finite vector is an error naming it."""
-    try:
-        a = np.asarray(v, float)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be a 3-vector, got {v!r}") from None
-    if a.shape != (3,):
-        raise ValueError(f"{name} must be a 3-vector, got shape {a.shape}")
-    n = np.linalg.norm(a)
-    if not np.isfinite(n) or n == 0:
-        raise ValueError(
-            f"{name} must be a finite non-zero vector (a direction), got {a.tolist()}"
-        )
-    return a / n
 
 
 def _check_cell_deg(cell_deg) -> float:

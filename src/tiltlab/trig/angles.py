@@ -118,23 +118,7 @@ def angles_from_quaternion(q, singular_tol: float = 1e-9) -> Orientation:
 
 
 def _check_rotation(C: np.ndarray, name: str) -> None:
-    ok = np.all(np.isfinite(C), axis=(-2, -1))
-    M = C[ok]
-    if M.size == 0:
-        return
-    err = np.abs(np.swapaxes(M, -1, -2) @ M - np.eye(3)).max(axis=(-2, -1))
-    if np.any(err > _UNIT_ATOL):
-        raise ValueError(
-            f"{name} must hold rotation matrices (orthonormal, det +1): "
-            f"{int((err > _UNIT_ATOL).sum())} have max |CᵀC − I| up to "
-            f"{float(err.max()):.3g}"
-        )
-    det = np.linalg.det(M)
-    if np.any(det < 0):
-        raise ValueError(
-            f"{name} must hold rotation matrices (det +1), got {int((det < 0).sum())} "
-            "reflection(s) (det −1)"
-        )
+    _quat.check_rotation(C, name, _UNIT_ATOL)
 
 
 def angles_from_matrix(matrix, singular_tol: float = 1e-9) -> Orientation:
