@@ -1,0 +1,30 @@
+"""Chapter 6 on another BROAD trial (rad/s gyroscope instead of the rat's deg/s)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from ._common import printed
+
+PARAMS = {"SOURCE": "broad:2", "IMMOBILE_DEG_S": 12.0}
+
+
+def check(nb_path: Path, params: dict) -> str:
+    """The immobile fraction the chapter prints equals Fayat's rules applied directly."""
+    from tiltlab import behavior, datasets
+
+    rec = datasets.load(params["SOURCE"])
+    expected = float(
+        behavior.immobility(
+            rec, threshold_deg_s=params["IMMOBILE_DEG_S"], gyr_offset="auto"
+        ).mean()
+    )
+    found = printed(nb_path, r"immobile ([0-9.]+)% of the time")
+    if not found:
+        raise AssertionError("the chapter printed no immobile fraction")
+    got = float(found[0]) / 100
+    if abs(got - expected) > 0.0005:
+        raise AssertionError(
+            f"chapter says {got:.1%} immobile, behavior.immobility gives {expected:.1%}"
+        )
+    return f"immobile fraction {got:.1%} (package: {expected:.1%})"
