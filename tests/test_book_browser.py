@@ -1,13 +1,21 @@
 """Open every page of the built book in headless Chromium and check what a reader sees.
 
+A page fails on: a JavaScript console error, raw TeX outside typeset math, a missing
+image, an image shown below 70 % of its natural width (its text would shrink), a
+traceback, a Python warning or stderr in an output, internal wording (test or benchmark
+paths, absolute machine paths, development vocabulary), a chapter number that disagrees
+with its file name, or exercises without hidden solutions.
+
 Needs the built book (``make book``) plus Debian's ``chromium`` and ``chromium-driver``.
 Without them the test is skipped, unless TILTLAB_REQUIRE_BOOK=1 (set by .ci/run), which
-turns a missing book or browser into a failure.
+turns a missing book or browser into a failure. TILTLAB_BOOK_HTML points at another
+build; TILTLAB_SCREENSHOTS=folder saves a full-page screenshot of every page there.
 """
 
 import functools
 import http.server
 import os
+import re
 import shutil
 import threading
 import time
@@ -18,7 +26,8 @@ import pytest
 pytestmark = pytest.mark.browser
 
 ROOT = Path(__file__).resolve().parents[1]
-HTML = ROOT / "book" / "_build" / "html"
+HTML = Path(os.environ.get("TILTLAB_BOOK_HTML", ROOT / "book" / "_build" / "html"))
+WIDTH = 1400  # px, the window a reader is assumed to have
 CHROMIUM_FLAGS = [
     "--headless",
     "--no-sandbox",
@@ -28,7 +37,25 @@ CHROMIUM_FLAGS = [
     "--disable-sync",
     "--no-first-run",
     "--disable-dev-shm-usage",
+    f"--window-size={WIDTH},1000",
+    "--hide-scrollbars",
 ]
+# wording that belongs to the repository, not to a reader
+INTERNAL = [
+    (r"\btests?/test_\w*", "a test file path"),
+    (r"\bbenchmarks/bench_\w*", "a benchmark file path"),
+    (
+        r"(?<![\w.~:/])/(?:work|tmp|home|root|usr|opt|var|mnt|srv|Users)/[\w.-]",
+        "an absolute path",
+    ),
+    (r"\bacceptance\b", "development vocabulary ('acceptance')"),
+    (r"\bseeds?/|\bseeds? \d{3}\b", "development vocabulary ('seeds')"),
+    (r"\.\./shared\b|\bsite-packages\b|\.venv/", "a machine path"),
+    (r"\bTILTLAB_REQUIRE_\w+", "a CI switch"),
+]
+RAW_TEX = re.compile(
+    r"\$\$|\\(?:frac|sum|mathrm|mathbf|begin|end|left|right|sqrt|cdot|hat|boldsymbol|operatorname)\b"
+)
 
 
 def _skip_or_fail(why: str):
@@ -81,6 +108,7 @@ def browser():
     from selenium.webdriver.chrome.service import Service
 
     opts = webdriver.ChromeOptions()
+    opts.set_capability("goog:loggingPrefs", {"browser": "ALL"})
     opts.binary_location = chromium
     for f in CHROMIUM_FLAGS:
         opts.add_argument(f)
@@ -107,30 +135,84 @@ def test_toc_lists_pages():
     )
 
 
+def _text_outside(browser, drop: str) -> str:
+    """The page's visible text with the elements matching ``drop`` removed."""
+    return browser.execute_script(
+        """
+        const main = document.querySelector('main') || document.body;
+        const copy = main.cloneNode(true);
+        copy.querySelectorAll(arguments[0]).forEach(e => e.remove());
+        document.body.appendChild(copy);
+        copy.style.position = 'absolute'; copy.style.left = '-20000px';
+        const text = copy.innerText;
+        copy.remove();
+        return text;
+        """,
+        drop,
+    )
+
+
+def _screenshot(browser, page: str) -> None:
+    folder = os.environ.get("TILTLAB_SCREENSHOTS")
+    if not folder:
+        return
+    import base64
+
+    height = browser.execute_script("return document.documentElement.scrollHeight")
+    shot = browser.execute_cdp_cmd(
+        "Page.captureScreenshot",
+        {
+            "captureBeyondViewport": True,
+            "clip": {"x": 0, "y": 0, "width": WIDTH, "height": height, "scale": 1},
+        },
+    )
+    out = Path(folder) / (page.replace("/", "_").removesuffix(".html") + ".png")
+    out.parent.mkdir(parents=True, exist_ok=True)
+    out.write_bytes(base64.b64decode(shot["data"]))
+
+
 @pytest.mark.parametrize("page", chapter_pages())
 def test_page_renders(server, browser, page):
+    browser.get_log("browser")  # forget the previous page's messages
     browser.get(f"{server}/{page}")
     assert _wait_for(browser, "return document.readyState === 'complete'")
     title = browser.title
     assert "404" not in title and "Error" not in title, title
     text = browser.execute_script("return document.body.innerText")
     assert len(text) > 200, f"{page}: almost empty page"
+    problems = []
+
     # no Python error made it into the page
     for marker in ("Traceback (most recent call last)", "CellExecutionError"):
-        assert marker not in text, f"{page}: contains {marker!r}"
+        if marker in text:
+            problems.append(f"contains {marker!r}")
     errors = browser.execute_script(
-        "return document.querySelectorAll('div.output.error, .output_error, .cell_output .ansi-red-fg').length"
+        "return document.querySelectorAll('div.output.error, .output_error, .cell_output .ansi-red-fg, .cell_output .output.stderr').length"
     )
-    assert errors == 0, f"{page}: {errors} error outputs"
-    # every image is present, loaded and non-empty
+    if errors:
+        problems.append(f"{errors} error or stderr outputs")
+    outputs = browser.execute_script(
+        "return Array.from(document.querySelectorAll('.cell_output')).map(e => e.innerText).join('\\n')"
+    )
+    for warning in re.findall(r"\b\w*Warning: .{0,60}", outputs):
+        problems.append(f"a warning in an output: {warning!r}")
+
+    # every image is present, loaded, non-empty and not shrunk below 70 % of its width
     imgs = browser.execute_script(
-        "return Array.from(document.querySelectorAll('main img')).map(i => [i.currentSrc || i.src, i.complete, i.naturalWidth, i.naturalHeight])"
+        "return Array.from(document.querySelectorAll('main img')).map(i => [i.currentSrc || i.src, i.complete, i.naturalWidth, i.naturalHeight, i.getBoundingClientRect().width])"
     )
-    for src, complete, w, h in imgs:
-        assert complete and w > 0 and h > 0, f"{page}: image not loaded {src}"
-    if page.startswith("notebooks/"):
-        assert len(imgs) >= 1, f"{page}: a chapter without any figure"
-    # math: any TeX on the page has been typeset by the vendored MathJax
+    for src, complete, w, h, shown in imgs:
+        name = src.rsplit("/", 1)[-1]
+        if not (complete and w > 0 and h > 0):
+            problems.append(f"image not loaded {name}")
+        elif shown < 0.7 * w:
+            problems.append(
+                f"image {name} shown at {shown:.0f} of {w} px ({shown / w:.0%}): its text shrinks"
+            )
+    if page.startswith("notebooks/") and not imgs:
+        problems.append("a chapter without any figure")
+
+    # math: any TeX on the page has been typeset by the vendored MathJax ...
     has_math = browser.execute_script(
         "return document.querySelectorAll('.math').length"
     )
@@ -140,14 +222,81 @@ def test_page_renders(server, browser, page):
         typeset = _wait_for(
             browser, "return document.querySelectorAll('mjx-container').length"
         )
-        assert typeset >= has_math, (
-            f"{page}: {has_math} math elements but {typeset} typeset"
-        )
         raw = browser.execute_script(
             "return Array.from(document.querySelectorAll('.math')).filter(e => !e.querySelector('mjx-container')).length"
         )
-        assert raw == 0, f"{page}: {raw} math elements left as raw TeX"
+        if typeset < has_math or raw:
+            problems.append(
+                f"{has_math} math elements, {typeset} typeset, {raw} left raw"
+            )
         errs = browser.execute_script(
             "return document.querySelectorAll('mjx-merror').length"
         )
-        assert errs == 0, f"{page}: {errs} MathJax errors"
+        if errs:
+            problems.append(f"{errs} MathJax errors")
+    # ... and no TeX is left in the text around it (code cells are allowed TeX)
+    prose = _text_outside(
+        browser, "mjx-container, .math, .cell_input, pre, code, script, style"
+    )
+    for m in RAW_TEX.finditer(prose):
+        problems.append(
+            f"raw TeX in the text: …{prose[max(0, m.start() - 40) : m.end() + 20]!r}…"
+        )
+
+    # internal wording
+    for pattern, what in INTERNAL:
+        for m in re.finditer(pattern, text):
+            problems.append(f"{what}: {text[max(0, m.start() - 30) : m.end() + 30]!r}")
+
+    # chapters: the rendered number agrees with the file, and exercises have hidden solutions
+    h1 = browser.execute_script(
+        "const h = document.querySelector('main section > h1'); return h ? h.innerText : ''"
+    )
+    m = re.match(r"notebooks/(\d\d)_", page)
+    if m:
+        if not re.match(rf"^{int(m.group(1))}\.\s", h1):
+            problems.append(f"rendered title {h1!r} is not chapter {int(m.group(1))}")
+        hidden = browser.execute_script(
+            """
+            const sec = Array.from(document.querySelectorAll('main section'))
+                .find(s => s.querySelector(':scope > h2') &&
+                           /Exercises/.test(s.querySelector(':scope > h2').innerText));
+            if (!sec) return -1;
+            return Array.from(sec.querySelectorAll('details.hide, .toggle-hidden, details'))
+                .filter(d => !d.open).length;
+            """
+        )
+        if hidden < 2:
+            problems.append(
+                "no Exercises section"
+                if hidden < 0
+                else "fewer than 2 hidden solutions"
+            )
+    elif page == "intro.html" and h1.strip() != "Introduction":
+        problems.append(f"the home page is titled {h1!r}, not 'Introduction'")
+
+    # the browser itself reported nothing wrong
+    for entry in browser.get_log("browser"):
+        if entry["level"] == "SEVERE":
+            problems.append(f"console error: {entry['message'][:200]}")
+
+    _screenshot(browser, page)
+    assert not problems, f"{page}:\n  " + "\n  ".join(problems)
+
+
+def test_bibliography_lists_every_cited_work(server, browser):
+    """Every key cited with {cite} in a page of the book appears in the bibliography."""
+    cited = set()
+    for path in [*(ROOT / "notebooks").glob("*.ipynb"), *(ROOT / "book").glob("*.md")]:
+        for group in re.findall(r"\{cite(?::\w+)?\}`([^`]+)`", path.read_text()):
+            cited |= {k.strip() for k in group.replace("\\n", " ").split(",")}
+    browser.get(f"{server}/bibliography.html")
+    assert _wait_for(browser, "return document.readyState === 'complete'")
+    entries = browser.execute_script(
+        "return document.querySelectorAll('main div.citation').length"
+    )
+    # sphinxcontrib-bibtex lists cited works only, and a key missing from the .bib file
+    # fails the build; so the page must hold exactly one entry per cited key
+    assert entries == len(cited), (
+        f"{len(cited)} works cited, {entries} listed in the bibliography"
+    )
