@@ -196,6 +196,18 @@ def test_page_renders(server, browser, page):
     )
     for warning in re.findall(r"\b\w*Warning: .{0,60}", outputs):
         problems.append(f"a warning in an output: {warning!r}")
+    # outputs are for reading: no raw xarray/dict reprs, no 16-digit floats
+    reprs = browser.execute_script(
+        "return document.querySelectorAll('.cell_output .xr-wrap').length"
+    )
+    if reprs or "<xarray." in outputs:
+        problems.append("a raw xarray repr in an output")
+    for m in re.finditer(r"^\{'\w+': .{0,60}", outputs, re.M):
+        problems.append(f"a raw dict in an output: {m.group(0)!r}")
+    for m in re.finditer(r"(?<![\w.])-?\d+\.\d{9,}", outputs):
+        problems.append(
+            f"a {len(m.group(0))}-character float in an output: {m.group(0)}"
+        )
 
     # every image is present, loaded, non-empty and not shrunk below 70 % of its width
     imgs = browser.execute_script(

@@ -262,3 +262,29 @@ def test_mocap_reference_recovers_truth():
     assert 0.01 < np.isnan(err).mean() < 0.05
     with pytest.raises(ValueError):
         E.mocap_reference(rec.drop_vars("sync"), mocap, gyr_offset=np.zeros(3))
+
+
+# ------------------------------------------------------------------ one table per trial
+
+
+def test_error_summary_matches_broad_rmse_and_statistics():
+    rec, q = _rec(n=900)
+    movement = np.zeros(900, bool)
+    movement[300:] = True
+    rec = rec.assign(movement=(("time",), movement))
+    est = {m: F.estimate(rec, m) for m in ("madgwick", "lowpass")}
+    table = E.error_summary(est, rec)
+    assert list(table.index) == ["madgwick", "lowpass"]
+    assert list(table.columns) == ["rmse", "mean", "median", "q95", "n"]
+    assert table.attrs["mask"] == "movement" and (table["n"] == 600).all()
+    for m, qe in est.items():
+        assert table.loc[m, "rmse"] == pytest.approx(E.tilt_rmse(qe, rec), abs=1e-6)
+    # without the mask variable every sample is scored; a direction reference works too
+    whole = E.error_summary(est, rec.drop_vars("movement"), ref="tilt_ref")
+    assert whole.attrs["mask"] is None and (whole["n"] == 900).all()
+    e = E.tilt_errors(est["madgwick"], q)
+    assert whole.loc["madgwick", "median"] == pytest.approx(np.median(e), abs=1e-9)
+    with pytest.raises(ValueError, match="ground truth"):
+        E.error_summary(est, rec.drop_vars("q_ref"))
+    with pytest.raises(ValueError, match="empty"):
+        E.error_summary({}, rec)

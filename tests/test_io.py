@@ -384,3 +384,71 @@ def test_csv_full_scale_from_the_mapping(tmp_path):
         io.read_csv_mapping({**MAPPING, "range": {"mag": 4900}})
     with pytest.raises(ValueError, match="'range' must map variables"):
         io.read_csv_mapping({**MAPPING, "range": 16})
+
+
+def test_csv_scale_reads_columns_in_mg_or_counts(tmp_path):
+    p = tmp_path / "s.csv"
+    acc, gyr, _ = _lab_csv(p)
+    # a factor from the column's numbers to the units (here: gyroscope counts of 2 °/s)
+    rec = io.read_csv(p, mapping=MAPPING, scale={"gyr": 2.0})
+    np.testing.assert_allclose(rec.gyr.values, 2.0 * gyr)
+    np.testing.assert_array_equal(rec.acc.values, acc)
+    assert rec.attrs["csv_scale"] == {"gyr": 2.0}
+    checked = io.read_csv_mapping({**MAPPING, "scale": {"acc": 0.5}})
+    assert checked["scale"] == {"acc": 0.5}
+    assert io.read_csv_mapping(MAPPING)["scale"] == {}
+    # a prefixed or raw unit is refused with the scale that reads it
+    with pytest.raises(
+        ValueError,
+        match=r"'mg' looks like milli-g: give units \{'acc': 'g'\} and scale",
+    ):
+        io.read_csv_mapping({**MAPPING, "units": {"acc": "mg", "gyr": "deg/s"}})
+    with pytest.raises(ValueError, match="'mdps' looks like milli-deg/s"):
+        io.read_csv_mapping({**MAPPING, "units": {"acc": "g", "gyr": "mdps"}})
+    with pytest.raises(ValueError, match="for raw ADC counts give the physical unit"):
+        io.read_csv_mapping({**MAPPING, "units": {"acc": "LSB", "gyr": "deg/s"}})
+    with pytest.raises(ValueError, match=r"scale\['acc'\] must be"):
+        io.read_csv_mapping({**MAPPING, "scale": {"acc": 0}})
+    with pytest.raises(
+        ValueError, match=r"scale\['mag'\]: a factor is given for a mapped"
+    ):
+        io.read_csv_mapping({**MAPPING, "scale": {"mag": 0.1}})
+    with pytest.raises(ValueError, match="'scale' must map variables to factors"):
+        io.read_csv_mapping({**MAPPING, "scale": 0.001})
+
+
+def test_csv_dropped_samples_are_refused_or_kept_as_nan(tmp_path):
+    p = tmp_path / "s.csv"
+    acc, gyr, t = _lab_csv(p, fs=100.0)
+    lines = p.read_text().splitlines(keepends=True)
+    # the logger lost samples 200–204 (five rows of data, after the header)
+    p.write_text("".join(lines[:201] + lines[206:]))
+    with pytest.raises(
+        schema.RecordingError,
+        match=r"skips samples \(1 gap: 0\.05 s at t = .*gaps='nan'",
+    ):
+        io.read_csv(p, mapping=MAPPING)
+    rec = io.read_csv(p, mapping={**MAPPING, "gaps": "nan"})
+    assert rec.sizes["time"] == 600 and rec.attrs["fs"] == pytest.approx(100.0)
+    assert np.isnan(rec.acc.values[200:205]).all()
+    np.testing.assert_array_equal(rec.acc.values[205:], acc[205:])
+    np.testing.assert_allclose(rec.time.values, t / 1e3, rtol=1e-12)
+    assert rec.attrs["gaps"].startswith("5 missing samples filled with NaN; 1 gap")
+    schema.validate(rec, allow_nan=True)
+    # a gap-free file is unchanged by gaps="nan"
+    q = tmp_path / "q.csv"
+    _lab_csv(q, fs=100.0)
+    assert "gaps" not in io.read_csv(q, mapping=MAPPING, gaps="nan").attrs
+    with pytest.raises(ValueError, match="gaps must be one of 'raise', 'nan'"):
+        io.read_csv_mapping({**MAPPING, "gaps": "fill"})
+    # samples off the 1/fs grid cannot be placed
+    r = tmp_path / "r.csv"
+    lines = [lines[0]] + [
+        ",".join(
+            [f"{1234.5 + 10 * i + (15 if i > 300 else 0):.17g}", *row.split(",")[1:]]
+        )
+        for i, row in enumerate(lines[1:])
+    ]
+    r.write_text("".join(lines))
+    with pytest.raises(schema.RecordingError, match="not on a regular grid"):
+        io.read_csv(r, mapping=MAPPING, fs=100.0, gaps="nan")

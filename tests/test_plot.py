@@ -312,3 +312,31 @@ def test_group_lines_median_and_iqr():
     assert len(legend_texts(ax)) == 2
     with pytest.raises(ValueError, match="err"):
         plot.group_lines(df, "v", x="t", hue="group", err="ci")
+
+
+# ---------------------------------------------------------------------------
+# several estimates of one recording
+# ---------------------------------------------------------------------------
+
+
+def test_estimates_overview_one_legend_log_errors():
+    from tiltlab import quaternion as Q
+
+    n = 600
+    t = np.arange(n) / FS
+    rng = np.random.default_rng(2)
+    q = Q.integrate_gyro(0.5 * rng.normal(size=(n, 3)), FS, np.array([1.0, 0, 0, 0]))
+    est = {"a": q, "b": Q.normalize(q + 0.01 * rng.normal(size=q.shape))}
+    errs = {"a": np.full(n, 0.5), "b": np.abs(rng.normal(size=n)) + 0.1}
+    fig = plot.estimates_overview(est, reference=q, errors=errs, time=t)
+    top, bottom = fig.axes
+    assert fig.get_figwidth() <= 8.4
+    assert len(fig.legends) == 1 and top.get_legend() is None
+    assert [x.get_text() for x in fig.legends[0].get_texts()] == ["a", "b", "reference"]
+    assert "°" in top.get_ylabel() and "(s)" in bottom.get_xlabel()
+    assert bottom.get_yscale() == "log"
+    # a constant error has a constant running RMS; no reference: one panel
+    assert np.allclose(plot.running_rms(errs["a"], 25), 0.5)
+    assert len(plot.estimates_overview(est, time=t).axes) == 1
+    angle = plot.tilt_angle_deg(np.array([[1.0, 0, 0, 0], [np.nan] * 4]))
+    assert angle[0] == pytest.approx(0.0) and np.isnan(angle[1])

@@ -38,6 +38,7 @@ __all__ = [
     "read_csv_mapping",
     "TIME_UNITS",
     "FS_RANGE",
+    "GAP_POLICIES",
     "save_netcdf",
     "load_netcdf",
 ]
@@ -345,6 +346,10 @@ _TIME_ALIASES = {"s": "s", "sec": "s", "ms": "ms", "us": "us", "µs": "us", "μs
 #: outside this range almost always means a time column in the wrong unit.
 FS_RANGE: tuple[float, float] = (1.0, 20_000.0)
 
+#: What :func:`read_csv` does with samples missing from the time column (dropped by a
+#: logger): refuse the file, or put NaN rows in their place.
+GAP_POLICIES: tuple[str, ...] = ("raise", "nan")
+
 #: Number of columns each Recording variable takes from a CSV.
 _WIDTH = {"acc": 3, "gyr": 3, "mag": 3, "temp": 1, "q_ref": 4}
 _MAPPING_KEYS = (
@@ -356,6 +361,8 @@ _MAPPING_KEYS = (
     "time_units",
     "fs_range",
     "range",
+    "scale",
+    "gaps",
     "attrs",
     "read_csv",
 )
@@ -375,6 +382,36 @@ def _time_factor(time_units: str, where: str) -> float:
             f"{where}time_units must be one of 's', 'ms', 'us', got {time_units!r}"
         )
     return TIME_UNITS[key]
+
+
+_RAW_UNITS = {"counts", "count", "lsb", "raw", "adc", "digits", "bits"}
+
+
+def _scaled_unit_hint(var: str, unit: object) -> str:
+    """A hint for a unit that is a known one with a prefix (``mg``, ``mdps``) or raw
+    ADC counts: read the column with a ``scale`` factor instead."""
+    if not isinstance(unit, str):
+        return ""
+    key = unit.strip()
+    if key.lower() in _RAW_UNITS:
+        example = {"acc": ("g", "1/16384 (±2 g)"), "gyr": ("deg/s", "1/131 (±250 °/s)")}
+        u, f = example.get(var, ("its physical unit", "1/sensitivity"))
+        return (
+            f"; for raw ADC counts give the physical unit and a factor, e.g. "
+            f"units {{{var!r}: {u!r}}} and scale {{{var!r}: {f}}}"
+        )
+    for prefix, factor in (("m", "0.001"), ("milli", "0.001"), ("milli-", "0.001")):
+        rest = key[len(prefix) :]
+        if key.startswith(prefix) and rest:
+            try:
+                canon = _units.normalise_unit(rest)
+            except _units.UnitsError:
+                continue
+            return (
+                f"; {unit!r} looks like milli-{canon}: give units {{{var!r}: {canon!r}}} "
+                f"and scale {{{var!r}: {factor}}}"
+            )
+    return ""
 
 
 def _load_mapping(mapping: Mapping[str, Any] | PathLike) -> tuple[dict[str, Any], str]:
@@ -454,7 +491,9 @@ def _check_mapping(raw: Mapping[str, Any], where: str) -> dict[str, Any]:
         try:
             units[var] = _units.normalise_unit(unit)
         except _units.UnitsError as exc:
-            raise ValueError(f"{where}units[{var!r}]: {exc}") from None
+            raise ValueError(
+                f"{where}units[{var!r}]: {exc}{_scaled_unit_hint(var, unit)}"
+            ) from None
     for var in cols:
         if var != "q_ref" and var not in units:
             raise ValueError(
@@ -526,6 +565,25 @@ def _check_mapping(raw: Mapping[str, Any], where: str) -> dict[str, Any]:
         except ValueError as exc:
             raise ValueError(str(exc)) from None
         full[var] = hi if np.isclose(-lo, hi) else [lo, hi]
+    scale: dict[str, float] = {}
+    scale_in = raw.get("scale") or {}
+    if not isinstance(scale_in, Mapping):
+        raise ValueError(
+            f"{where}'scale' must map variables to factors, e.g. "
+            '{"acc": 0.001} for a column in mg read as g'
+        )
+    for var, value in scale_in.items():
+        if var not in cols or var == "q_ref":
+            raise ValueError(
+                f"{where}scale[{var!r}]: a factor is given for a mapped acc, gyr, mag "
+                "or temp only"
+            )
+        scale[var] = _validate.positive(value, f"{where}scale[{var!r}]")
+    gaps = raw.get("gaps") or "raise"
+    if gaps not in GAP_POLICIES:
+        raise ValueError(
+            f"{where}gaps must be one of {', '.join(map(repr, GAP_POLICIES))}, got {gaps!r}"
+        )
     attrs = raw.get("attrs") or {}
     if not isinstance(attrs, Mapping):
         raise ValueError(
@@ -551,6 +609,8 @@ def _check_mapping(raw: Mapping[str, Any], where: str) -> dict[str, Any]:
         "time_scale": float(time_scale),
         "fs_range": fs_range,
         "range": full,
+        "scale": scale,
+        "gaps": gaps,
         "attrs": dict(attrs),
         "read_csv": read_kwargs,
     }
@@ -580,7 +640,13 @@ def read_csv_mapping(mapping: Mapping[str, Any] | PathLike) -> dict[str, Any]:
         time column (default seconds); ``fs_range`` ([low, high] Hz, ``null`` to
         disable) bounds a plausible sampling rate; ``range`` (variable → full scale in
         its units, ``r`` for ±r or ``[low, high]``, for ``acc``, ``gyr``, ``mag``) is the
-        sensor's measurement range, used to find clipped samples; ``attrs`` are extra
+        sensor's measurement range, used to find clipped samples; ``scale`` (variable →
+        positive factor from the column's numbers to ``units``, for ``acc``, ``gyr``,
+        ``mag``, ``temp``; e.g. ``{"acc": 0.001}`` for a column in mg with
+        ``units["acc"] = "g"``, or 1/16384 g per count for raw counts at ±2 g) converts
+        columns in units tiltlab does not name; ``gaps`` (``"raise"`` or ``"nan"``,
+        see :func:`read_csv`) handles samples missing from the time column; ``attrs``
+        are extra
         Recording attributes; any other key is a :func:`pandas.read_csv` option (``sep``,
         ``decimal``, ``skiprows``, ``comment``, ``encoding``…), or put them under
         ``read_csv``.
@@ -590,7 +656,8 @@ def read_csv_mapping(mapping: Mapping[str, Any] | PathLike) -> dict[str, Any]:
     dict
         Keys ``columns`` (variable → list of names), ``units`` (canonical spellings),
         ``fs`` (float or None), ``time_column``, ``time_scale`` (factor to seconds),
-        ``fs_range``, ``range`` (variable → full scale), ``attrs`` and ``read_csv`` (options for :func:`pandas.read_csv`).
+        ``fs_range``, ``range`` (variable → full scale), ``scale`` (variable →
+        factor), ``gaps``, ``attrs`` and ``read_csv`` (options for :func:`pandas.read_csv`).
 
     Raises
     ------
@@ -671,7 +738,13 @@ def read_csv(
         A whole mapping (``columns``, ``units``, ``fs``, ``time_column``, ``time_units``
         …, see :func:`read_csv_mapping`), or the path of a JSON file holding one.
         Arguments given explicitly override it (``units`` and ``attrs`` are merged); its
-        ``range`` (variable → the sensor's full scale) may also be given as a keyword.
+        ``range`` (variable → the sensor's full scale) and ``scale`` (variable → factor
+        from the column's numbers to its ``units``, e.g. ``{"acc": 0.001}`` for mg) may
+        also be given as keywords. The factors are kept in ``attrs['csv_scale']``.
+        So may ``gaps``: ``"raise"`` (default) refuses a time column that skips samples
+        (steps longer than 1.5/fs, a logger that dropped samples); ``"nan"`` inserts
+        NaN rows in their place, keeps a description in ``attrs['gaps']`` and
+        validates with ``allow_nan``.
     fs : float, optional
         Sampling rate (Hz). If omitted, ``time_column`` is required and ``fs`` is
         estimated as 1 / median interval, to 7 significant digits (recorded in
@@ -704,7 +777,8 @@ def read_csv(
     ValueError
         If the mapping is incomplete or inconsistent, or the sampling rate implausible.
     RecordingError
-        If the data break the Recording contract.
+        If the data break the Recording contract, or the time column skips samples
+        (unless ``gaps="nan"``).
     """
     path = Path(path)
     raw: dict[str, Any] = {}
@@ -738,6 +812,10 @@ def read_csv(
         raw["attrs"] = {**(raw.get("attrs") or {}), **attrs}
     if "range" in read_kwargs:  # the sensor's full scale, as in a mapping
         raw["range"] = read_kwargs.pop("range")
+    if "scale" in read_kwargs:  # factors from the columns' numbers to the units
+        raw["scale"] = read_kwargs.pop("scale")
+    if "gaps" in read_kwargs:  # what to do with samples the logger dropped
+        raw["gaps"] = read_kwargs.pop("gaps")
     nested = read_kwargs.pop("read_csv", None) or {}
     if not isinstance(nested, Mapping):
         raise ValueError("read_csv must be a mapping of pandas.read_csv options")
@@ -749,9 +827,11 @@ def read_csv(
     if tcol:
         roles.setdefault(tcol, "time_column")
     df = _read_table(path, list(roles), roles=roles, **m["read_csv"])
-    get = {k: df[v].to_numpy(float) for k, v in cols.items()}
+    get = {k: df[v].to_numpy(float) * m["scale"].get(k, 1.0) for k, v in cols.items()}
     time = None
     extra_attrs = dict(m["attrs"])
+    if m["scale"]:
+        extra_attrs["csv_scale"] = dict(m["scale"])
     fs, lo_hi = m["fs"], m["fs_range"]
     if tcol:
         raw_time = df[tcol].to_numpy(float)
@@ -787,6 +867,17 @@ def read_csv(
             f"{path}: fs = {fs:g} Hz is outside the plausible range {lo_hi[0]:g}–{lo_hi[1]:g} Hz "
             "(give fs_range to accept it)"
         )
+    allow_nan = False
+    if time is not None:
+        time, get, missing = _place_on_grid(time, get, fs, tcol, path, m["gaps"])
+        if missing:
+            allow_nan = True
+            extra_attrs["gaps"] = (
+                f"{missing} missing sample{'s' if missing != 1 else ''} filled with NaN; "
+                + _validate.describe_gaps(
+                    time, fs, _validate.segments(time, fs, values=get["acc"])
+                )
+            )
     return schema.make_recording(
         get["acc"],
         get["gyr"],
@@ -803,7 +894,52 @@ def read_csv(
         q_ref=get.get("q_ref"),
         time=time,
         attrs={"source": path.name, **extra_attrs},
+        allow_nan=allow_nan,
     )
+
+
+def _place_on_grid(
+    time: np.ndarray,
+    get: dict[str, np.ndarray],
+    fs: float,
+    tcol: str,
+    path: Path,
+    gaps: str,
+) -> tuple[np.ndarray, dict[str, np.ndarray], int]:
+    """Find samples missing from a time column (steps of about k/fs, k ≥ 2): refuse
+    them (``gaps="raise"``) or insert NaN rows in their place (``"nan"``); return the
+    time, the columns and the number of samples inserted."""
+    segs = _validate.segments(time, fs)
+    if len(segs) <= 1:
+        return time, get, 0
+    pos = (time - time[0]) * fs
+    k = np.rint(pos).astype(np.int64)
+    n_missing = int(k[-1] + 1 - k.size)
+    where = _validate.describe_gaps(time, fs, segs)
+    if gaps == "raise":
+        raise schema.RecordingError(
+            f"{path}: time column {tcol!r} skips samples ({where}"
+            + (f"; about {n_missing} samples missing" if n_missing > 0 else "")
+            + "): the logger dropped samples, or fs is wrong. "
+            "Read with gaps='nan' to keep the gaps as NaN rows (orientation filters "
+            "then run on each gap-free segment, estimate(..., gaps='segments'))"
+        )
+    if np.any(np.abs(pos - k) > 0.35) or np.any(np.diff(k) < 1):
+        i = int(np.argmax((np.abs(pos - k) > 0.35) | np.r_[False, np.diff(k) < 1]))
+        raise schema.RecordingError(
+            f"{path}: time column {tcol!r} is not on a regular grid of 1/fs = "
+            f"{1 / fs:.6g} s (data row {i}: {pos[i]:.2f} sample periods after the "
+            "first); cannot place the gaps, give the right fs"
+        )
+    n = int(k[-1] + 1)
+    full_time = time[0] + np.arange(n) / fs
+    full_time[k] = time
+    out = {}
+    for var, v in get.items():
+        filled = np.full((n, *v.shape[1:]), np.nan)
+        filled[k] = v
+        out[var] = filled
+    return full_time, out, n - k.size
 
 
 _ATTRS_KEY = "_tiltlab_attrs_json"

@@ -25,6 +25,7 @@ Submodules (all public names are re-exported here):
 * :mod:`~tiltlab.calibration.alignment` — head frame from markers, marker QC, Kabsch
   alignment, mounting rotation;
 * :mod:`~tiltlab.calibration.apply` — the :class:`Calibration` record and :func:`calibrate`.
+* :mod:`~tiltlab.calibration.published` — LaCanna's drift tables (not re-exported here).
 """
 
 from ._util import CalibrationError

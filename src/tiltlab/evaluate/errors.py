@@ -22,6 +22,7 @@ __all__ = [
     "shifted_score",
     "tilt_errors",
     "error_stats",
+    "error_summary",
     "table1",
     "state_scores",
     "binned_by_speed",
@@ -263,6 +264,66 @@ def error_stats(errors, mask=None) -> dict[str, float]:
         "rmse": float(np.sqrt(np.mean(e * e))),
         "n": int(e.size),
     }
+
+
+def error_summary(
+    estimates: Mapping[str, Any],
+    rec: xr.Dataset,
+    *,
+    ref: str = "q_ref",
+    mask: str | None = "movement",
+) -> pd.DataFrame:
+    r"""Tilt errors of several estimates of one recording, one row per estimate.
+
+    The table to show after running each filter once on a trial: per-sample tilt errors
+    (:func:`tilt_errors`) against the recording's reference, summarised over the samples
+    selected by ``mask`` (BROAD scores its ``movement`` samples) where the reference is
+    finite.
+
+    Parameters
+    ----------
+    estimates : mapping str → array_like or xarray.DataArray, shape (N, 4)
+        Estimated orientations (sensor → world) of ``rec``'s samples, by method.
+    rec : xarray.Dataset
+        Recording holding the reference ``ref``.
+    ref : str
+        Reference variable: quaternions (time, quat), e.g. ``q_ref``, or gravity-up
+        directions (time, axis), e.g. ``tilt_ref``.
+    mask : str or None
+        Boolean variable of ``rec`` selecting the scored samples; ignored when ``rec``
+        has no such variable (all samples are scored). ``None``: all samples.
+
+    Returns
+    -------
+    pandas.DataFrame
+        Index ``method``; columns ``rmse``, ``mean``, ``median``, ``q95`` (degrees) and
+        ``n`` (samples scored). With ``ref="q_ref"`` and ``mask="movement"``, ``rmse`` is
+        BROAD's inclination RMSE (:func:`tilt_rmse`). ``attrs["mask"]`` names the mask
+        used (``None`` when all samples were scored).
+
+    Raises
+    ------
+    ValueError
+        If ``estimates`` is empty or ``rec`` has no variable ``ref``.
+    """
+    if not estimates:
+        raise ValueError("estimates is empty")
+    if ref not in rec:
+        raise ValueError(
+            f"recording has no reference {ref!r}: tilt errors need ground truth"
+        )
+    used = mask if mask is not None and mask in rec else None
+    sel = rec[used].values.astype(bool) if used is not None else None
+    rows = {}
+    for name, q in estimates.items():
+        st = error_stats(tilt_errors(q, rec[ref].values), sel)
+        rows[name] = {k: st[k] for k in ("rmse", "mean", "median", "q95", "n")}
+    df = pd.DataFrame.from_dict(rows, orient="index")
+    df.index.name = "method"
+    df["n"] = df["n"].astype(int)
+    df.attrs["mask"] = used
+    df.attrs["units"] = "deg"
+    return df
 
 
 def table1(
