@@ -94,8 +94,8 @@ def tukey_boxplot(
     units = units if units is not None else u
     cats = _order(df, by, order)
     hues = _order(df, hue, hue_order) if hue is not None else [None]
-    # at most the book's column width (9 in); many boxes get narrower
-    width = min(9.0, max(4.0, 0.35 * len(cats) * max(1, len(hues))))
+    # at most the book's column width (8.4 in); few boxes get narrower
+    width = min(8.4, max(4.0, 0.35 * len(cats) * max(1, len(hues))))
     ax = new_axes(ax, figsize=(width, 3.5))
     width = 0.8 / len(hues)
     rng = np.random.default_rng(seed)
@@ -220,7 +220,7 @@ def group_lines(
     ax.set_xticks(range(len(xs)), [str(v) for v in xs], rotation=45)
     ax.set_xlabel(x)
     ax.set_ylabel(label(name or value, units))
-    legend_if_many(ax, title=hue, fontsize=7)
+    legend_if_many(ax, title=hue, fontsize=8)
     if title:
         ax.set_title(title)
     return ax

@@ -10,6 +10,7 @@ from collections.abc import Mapping, Sequence
 
 import matplotlib.pyplot as plt
 import numpy as np
+from matplotlib.ticker import MaxNLocator
 import pandas as pd
 
 from ._common import label, new_axes
@@ -21,7 +22,7 @@ def learning_curves(
     history: Mapping[str, Sequence[Mapping[str, float]]],
     *,
     key: str = "qae_deg",
-    figsize=(9, 3.5),
+    figsize=(8.4, 3.2),
 ):
     """Training curves: ``key`` per epoch, one line per fold, one panel per variant.
 
@@ -32,6 +33,7 @@ def learning_curves(
     key : str
         ``"qae_deg"`` (mean QAE of the training windows, degrees) or ``"loss"``.
     figsize : (float, float)
+        Figure size in inches (default: the book's column width).
 
     Returns
     -------
@@ -51,6 +53,7 @@ def learning_curves(
             )
         ax.set_title(variant)
         ax.set_xlabel("epoch")
+        ax.xaxis.set_major_locator(MaxNLocator(integer=True))
         ax.legend(title="model", fontsize=8, frameon=False)
     axes[0, 0].set_ylabel(
         label("training QAE", "deg") if key == "qae_deg" else "training loss"
@@ -66,7 +69,7 @@ def method_strips(
     hue: Mapping[int, str] | None = None,
     logy: bool = True,
     ax=None,
-    figsize=(9, 4),
+    figsize=(8.4, 4),
 ):
     """Per-trial errors as dots, one column per method, with each method's median.
 
@@ -81,6 +84,7 @@ def method_strips(
     logy : bool
     ax : matplotlib.axes.Axes, optional
     figsize : (float, float)
+        Size of a new figure in inches (default: the book's column width).
 
     Returns
     -------

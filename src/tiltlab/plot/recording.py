@@ -35,6 +35,9 @@ __all__ = [
 
 _AXIS_COLOURS = AXIS_COLOURS
 
+#: Default width (inches) of the full-width figures: the book's column at 100 dpi.
+FIG_WIDTH = 8.4
+
 
 def shade_mask(
     ax,
@@ -148,7 +151,7 @@ def plot_recording(
         len(variables),
         1,
         sharex=True,
-        figsize=figsize or (9, 2.0 * len(variables) + 0.6),
+        figsize=figsize or (FIG_WIDTH, 2.0 * len(variables) + 0.6),
         squeeze=False,
     )
     for ax, v in zip(axes[:, 0], variables):
@@ -221,7 +224,7 @@ def series_panels(
         1,
         sharex=sharex,
         squeeze=False,
-        figsize=figsize or (9, 1.9 * len(panels) + 0.8),
+        figsize=figsize or (FIG_WIDTH, 1.9 * len(panels) + 0.8),
     )
     for ax, (name, lines) in zip(axes[:, 0], panels.items()):
         if not isinstance(lines, Mapping):
@@ -290,7 +293,7 @@ def speed_trace(
     -------
     matplotlib.axes.Axes
     """
-    ax = new_axes(ax, figsize=(10, 3))
+    ax = new_axes(ax, figsize=(FIG_WIDTH, 3))
     u = units or units_of(speed, "deg/s")
     y = np.asarray(speed, float)
     t = (
