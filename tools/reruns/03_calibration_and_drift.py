@@ -1,0 +1,62 @@
+"""Chapter 3 on a simulated tumble test (12 Fibonacci orientations, a trigger channel,
+true offsets) instead of the real three-position test, with smaller simulated studies."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from ._common import printed
+
+# still-period settings of the rerun; the simulated holds last 4 s
+THRESHOLD, MIN_STILL_S = 3.0, 1.0
+
+
+def prepare(tmp: Path) -> dict:
+    """Simulate a 12-orientation tumble test, save it as NetCDF, shrink the studies."""
+    from tiltlab import io, simulate
+
+    rec = simulate.tumble_test(12, fs=100.0, seed=7, hold_s=4.0, move_s=1.0)
+    path = io.save_netcdf(rec, tmp / "tumble_sim.nc")
+    return {
+        "SOURCE": str(path),
+        "STILL_THRESHOLD": THRESHOLD,
+        "MIN_STILL_S": MIN_STILL_S,
+        "SEED": 7,
+        "N_LATTICE": 20,
+        "N_REPEATS": 2,
+        "DRIFT_HOURS": 0.25,
+        "MOCAP_S": 60.0,
+    }
+
+
+def check(nb_path: Path, params: dict) -> str:
+    """The still-period count and the first-pass gyro offset the chapter prints equal
+    the package's on the prepared file."""
+    import numpy as np
+
+    from tiltlab import calibration, datasets
+
+    rec = datasets.load(params["SOURCE"])
+    intervals = calibration.detect_static(
+        rec,
+        threshold_deg_s=params["STILL_THRESHOLD"],
+        min_duration_s=params["MIN_STILL_S"],
+    )
+    found = printed(nb_path, r"still periods found: (\d+)")
+    if not found:
+        raise AssertionError("the chapter printed no still-period count")
+    if int(found[0]) != len(intervals):
+        raise AssertionError(
+            f"chapter found {found[0]} still periods, detect_static gives {len(intervals)}"
+        )
+    off = printed(nb_path, r"first-pass gyro offset \([^)]*\): \[([^\]]+)\]")
+    if not off:
+        raise AssertionError("the chapter printed no first-pass gyro offset")
+    got = np.array(off[0].split(), float)
+    expected = calibration.robust_gyro_offset(rec)
+    if not np.allclose(got, expected, atol=1e-3):
+        raise AssertionError(f"chapter offset {got}, robust_gyro_offset {expected}")
+    return (
+        f"{len(intervals)} still periods, first-pass gyro offset "
+        f"{np.round(expected, 2).tolist()} deg/s (package agrees)"
+    )
