@@ -1,0 +1,41 @@
+"""Chapter 2 with another seed, smaller sizes and a BROAD trial (m/s², rad/s, 285.7 Hz)
+as the real recording of the realism check."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from ._common import printed
+
+PARAMS = {
+    "SOURCE": "broad:3",
+    "SEED": 5,
+    "DURATION_S": 120.0,
+    "N_TUMBLE": 20,
+    "MOCAP_DURATION_S": 20.0,
+    "COHORT_N_PER_GROUP": 1,
+    "COHORT_DURATION_S": 60.0,
+    "WORKERS": 1,
+    "THRESHOLD_DEG_S": 10.0,
+}
+
+
+def check(nb_path: Path, params: dict) -> str:
+    """The realism check analysed SOURCE: its fraction of time below the threshold, as
+    printed, equals the package's computation on that recording."""
+    from tiltlab import behavior, datasets
+
+    real = datasets.load(params["SOURCE"])
+    expected = float(
+        (behavior.recording_speed(real) < params["THRESHOLD_DEG_S"]).mean()
+    )
+    found = printed(nb_path, r"([0-9.]+)% of the time below ([0-9.]+) °/s")
+    if not found:
+        raise AssertionError("the chapter printed no fraction below the threshold")
+    got, threshold = float(found[0][0]) / 100, float(found[0][1])
+    if threshold != params["THRESHOLD_DEG_S"] or abs(got - expected) > 0.0006:
+        raise AssertionError(
+            f"chapter says {got:.1%} below {threshold:g} °/s, the package gives "
+            f"{expected:.1%} below {params['THRESHOLD_DEG_S']:g} °/s"
+        )
+    return f"{got:.1%} of {params['SOURCE']} below {threshold:g} °/s (package: {expected:.1%})"
