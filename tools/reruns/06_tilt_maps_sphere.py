@@ -1,4 +1,5 @@
-"""Chapter 6 on another BROAD trial (rad/s gyroscope instead of the rat's deg/s)."""
+"""Chapter 6 on another BROAD trial (rad/s gyroscope instead of the rat's deg/s), on a
+coarser lattice and with the heading maps of another trial."""
 
 from __future__ import annotations
 
@@ -6,7 +7,14 @@ from pathlib import Path
 
 from ._common import printed
 
-PARAMS = {"SOURCE": "broad:2", "IMMOBILE_DEG_S": 12.0}
+PARAMS = {
+    "SOURCE": "broad:2",
+    "IMMOBILE_DEG_S": 12.0,
+    "N_LATTICE": 2000,
+    "N_BOOT": 200,
+    "SIM_DURATION_S": 120.0,
+    "HEADING_SOURCE": "broad:3",
+}
 
 
 def check(nb_path: Path, params: dict) -> str:

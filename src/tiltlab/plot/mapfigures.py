@@ -39,6 +39,10 @@ __all__ = [
     "residence_figure",
 ]
 
+#: Widest default figure (inches): the book's column at its display resolution, so that
+#: figures are never shrunk and their text stays at least 8 pt.
+MAX_WIDTH_IN = 8.4
+
 # ---------------------------------------------------------------------------
 # figure recipes
 # ---------------------------------------------------------------------------
@@ -83,7 +87,7 @@ def map_grid(
     *,
     ncols: int | None = None,
     centre=(0.0, 0.0, 1.0),
-    panel_size: float = 4.6,
+    panel_size: float | None = None,
     figsize: tuple[float, float] | None = None,
     **kw,
 ):
@@ -97,8 +101,10 @@ def map_grid(
         Maps per row (default ``n`` up to 3).
     centre : array_like (3,) or sequence of them
         Map centre (direction), one for all or one per map.
-    panel_size : float
-        Width and height (inches) of one map when ``figsize`` is not given.
+    panel_size : float, optional
+        Width (inches) of one map when ``figsize`` is not given; the height adds room
+        for a legend below the map. Default: the grid fits the book's column,
+        ``min(4.2, MAX_WIDTH_IN / ncols)``.
     figsize : (float, float), optional
     **kw
         Passed to :func:`laea` (``nose_up``).
@@ -113,7 +119,12 @@ def map_grid(
         raise ValueError(f"n must be at least 1, got {n!r}")
     ncols = min(n, 3) if ncols is None else int(ncols)
     nrows = -(-n // ncols)
-    fig = plt.figure(figsize=figsize or (panel_size * ncols, panel_size * nrows))
+    if figsize is None:
+        panel = (
+            min(4.2, MAX_WIDTH_IN / ncols) if panel_size is None else float(panel_size)
+        )
+        figsize = (panel * ncols, (panel + 0.5) * nrows)
+    fig = plt.figure(figsize=figsize)
     c = np.asarray(centre, float)
     centres = [c] * n if c.ndim == 1 else list(c)
     if len(centres) != n:
@@ -251,7 +262,7 @@ def tilt_overview(
     log: bool = True,
     cmap="magma",
     traj_kw: dict | None = None,
-    figsize=(11, 4.6),
+    figsize=(MAX_WIDTH_IN, 3.8),
 ):
     """A 3-D sphere with the trajectory beside the LAEA heat map of the same tilt map.
 
@@ -265,6 +276,7 @@ def tilt_overview(
     traj_kw : dict, optional
         Style of the trajectory on the 3-D sphere.
     figsize : (float, float)
+        Default: the book's column width, 8.4 in.
 
     Returns
     -------
@@ -360,7 +372,7 @@ def visited_map(
                 color=c, alpha=alpha, label=f"{name} ({100 * frac:.1f} % of the sphere)"
             )
         )
-    decorate(ax, **({"fontsize": 7} | (decorate_kw or {})))
+    decorate(ax, **({"fontsize": 8} | (decorate_kw or {})))
     if legend:
         ax.legend(
             handles=handles,
@@ -494,7 +506,7 @@ def kde_map(
         if grid_step_deg is not None
         else (10.0 if extent is not None and extent < 1 else 30.0)
     )
-    decorate(ax, labels=labels, grid_step_deg=step, fontsize=7)
+    decorate(ax, labels=labels, grid_step_deg=step, fontsize=8)
     if colorbar:
         _colorbar(ax, art, name)
     ax.legend(
@@ -577,7 +589,7 @@ def tilt_points_map(
     ax.set_extent([-extent, extent, -extent, extent], crs=ax.projection)
     decorate(
         ax,
-        fontsize=7,
+        fontsize=8,
         grid_step_deg=grid_step_deg,
         labels={} if baseline is not None else None,
     )
@@ -632,7 +644,7 @@ def tilt_trace(tilt, *, ax=None, title: str | None = None, **kw):
         xlabel="LAEA x: ← left ear (+y)   right ear →",
         ylabel="LAEA y: nose (+x) ↑",
     )
-    ax.legend(loc="lower right", fontsize=7)
+    ax.legend(loc="lower right", fontsize=8)
     if title:
         ax.set_title(title, fontsize=9)
     return ax
@@ -663,6 +675,7 @@ def residence_figure(
         sample index to seconds first).
     cmap : str or Colormap
     figsize : (float, float), optional
+        Default 2.8 in per panel (8.4 in, the book's column, for three panels).
     panel_titles : (str, str)
 
     Returns
@@ -670,7 +683,7 @@ def residence_figure(
     matplotlib.figure.Figure
     """
     n = 3 if series is not None else 2
-    fig = plt.figure(figsize=figsize or (4.1 * n, 4.4))
+    fig = plt.figure(figsize=figsize or (MAX_WIDTH_IN / 3 * n, 3.4))
     visited = res.n_visits > 0
     for j, (name, v, u) in enumerate(
         [
@@ -686,7 +699,7 @@ def residence_figure(
             name=name.split(" per ")[0],
             units=u,
             cmap=cmap,
-            decorate_kw={"fontsize": 7},
+            decorate_kw={"fontsize": 8},
             title=name,
         )
     if series is not None:
