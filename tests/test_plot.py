@@ -338,5 +338,9 @@ def test_estimates_overview_one_legend_log_errors():
     # a constant error has a constant running RMS; no reference: one panel
     assert np.allclose(plot.running_rms(errs["a"], 25), 0.5)
     assert len(plot.estimates_overview(est, time=t).axes) == 1
+    # the error axis is labelled with plain numbers, not powers of ten
+    fig.canvas.draw()
+    labels = [x.get_text() for x in bottom.get_yticklabels() if x.get_text()]
+    assert labels and not any("10^" in x or "times" in x for x in labels)
     angle = plot.tilt_angle_deg(np.array([[1.0, 0, 0, 0], [np.nan] * 4]))
     assert angle[0] == pytest.approx(0.0) and np.isnan(angle[1])

@@ -22,7 +22,7 @@ Everything is re-exported here: ``from tiltlab import plot; plot.kde_map(k)``.
 """
 
 from .cohort import group_lines, tukey_boxplot
-from .filters import estimates_overview, running_rms, tilt_angle_deg
+from .filters import estimates_overview, plain_log_ticks, running_rms, tilt_angle_deg
 from .learning import learning_curves, method_strips
 from .mapfigures import (
     facet_map,
