@@ -36,8 +36,12 @@ def prepare(tmp: Path) -> dict:
 def check(nb_path: Path, params: dict) -> str:
     """The chapter analysed the prepared cohort (its groups and time points) and printed
     its tables: one Fayat block (lesion vs control, lesion vs sham, sham vs control)
-    between groups and every group against baseline, per feature and time point."""
+    between groups and every group against baseline, per feature and time point. The
+    circling index it printed for one session (§4) is the feature pipeline's, computed
+    here directly from that session's file and its tumble test."""
     import pandas as pd
+
+    from tiltlab import cohort
 
     manifest = pd.read_csv(params["COHORT_MANIFEST"])
     n_groups = manifest["group"].nunique()
@@ -61,4 +65,28 @@ def check(nb_path: Path, params: dict) -> str:
             f"chapter computed {tables} tables / {tests} tests, expected "
             f"{2 * n_features} / {expected}"
         )
-    return f"{tables} tables, {tests} tests on {groups} groups × {post} time points"
+    lines = printed(
+        nb_path,
+        r"(\S+) (\S+): max \|ω_z\(gravity\) − ω·g\| = \S+ °/s; circling index ([-+0-9.]+) /min",
+    )
+    if not lines:
+        raise AssertionError("the chapter printed no circling index (§4)")
+    subject, timepoint, index = lines[0]
+    table = cohort.read_manifest(params["COHORT_MANIFEST"])
+    rows = table.table
+    row = rows[(rows["subject"] == subject) & (rows["timepoint"] == timepoint)].iloc[0]
+    features = cohort.session_features(
+        cohort.load_session(row, table.root),
+        cohort.FeatureConfig(),
+        calibration=cohort.load_calibration(row, table.root),
+    )
+    circling = float(features["circling_index"])
+    if abs(float(index) - circling) > 0.0006:
+        raise AssertionError(
+            f"chapter says circling index {index} /min for {subject} {timepoint}, "
+            f"the feature pipeline {circling:+.3f} /min"
+        )
+    return (
+        f"{tables} tables, {tests} tests on {groups} groups × {post} time points; "
+        f"{subject} {timepoint} circling {index} /min (package: {circling:+.3f})"
+    )
