@@ -159,13 +159,15 @@ def _screenshot(browser, page: str) -> None:
     import base64
 
     height = browser.execute_script("return document.documentElement.scrollHeight")
-    shot = browser.execute_cdp_cmd(
-        "Page.captureScreenshot",
-        {
-            "captureBeyondViewport": True,
-            "clip": {"x": 0, "y": 0, "width": WIDTH, "height": height, "scale": 1},
-        },
+    # lay the whole page out in one tall viewport, as a reader scrolling it would see it
+    browser.execute_cdp_cmd(
+        "Emulation.setDeviceMetricsOverride",
+        {"width": WIDTH, "height": height, "deviceScaleFactor": 1, "mobile": False},
     )
+    browser.execute_script("window.scrollTo(0, 0)")
+    time.sleep(0.5)
+    shot = browser.execute_cdp_cmd("Page.captureScreenshot", {"format": "png"})
+    browser.execute_cdp_cmd("Emulation.clearDeviceMetricsOverride", {})
     out = Path(folder) / (page.replace("/", "_").removesuffix(".html") + ".png")
     out.parent.mkdir(parents=True, exist_ok=True)
     out.write_bytes(base64.b64decode(shot["data"]))
