@@ -346,7 +346,8 @@ def speed_histogram(
     speeds : array_like, xarray.DataArray or mapping str → array_like
         One speed series, or several (one step histogram each, with a legend).
     thresholds : float or mapping str → float, optional
-        Threshold(s) (same units) drawn as vertical lines.
+        Threshold(s) (same units) drawn as vertical lines; a single value is labelled
+        with its units ("threshold 12 °/s"), a mapping by its names.
     bins : int or array_like
         Bins in log10 speed.
     units : str, optional
@@ -378,7 +379,7 @@ def speed_histogram(
         th = (
             thresholds
             if isinstance(thresholds, Mapping)
-            else {f"{thresholds:g}": thresholds}
+            else {f"{thresholds:g} {pretty_units(u)}".strip(): thresholds}
         )
         for k, (name, v) in enumerate(th.items()):
             ax.axvline(
