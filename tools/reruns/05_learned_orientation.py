@@ -20,7 +20,7 @@ def check(nb_path: Path, params: dict) -> str:
     from tiltlab import datasets, evaluate, learn
 
     found = printed(
-        nb_path, r"compared (\d+) methods on (\d+) held-out trials: \[([0-9, ]*)\]"
+        nb_path, r"compared (\d+) methods on (\d+) held-out trials:\n([0-9,\s]*)"
     )
     if not found:
         raise AssertionError("the chapter printed no comparison line")

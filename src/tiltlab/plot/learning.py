@@ -10,7 +10,7 @@ from collections.abc import Mapping, Sequence
 
 import matplotlib.pyplot as plt
 import numpy as np
-from matplotlib.ticker import MaxNLocator
+from matplotlib.ticker import FuncFormatter, MaxNLocator
 import pandas as pd
 
 from ._common import label, new_axes
@@ -117,6 +117,8 @@ def method_strips(
     )
     if logy:
         ax.set_yscale("log")
+        # plain numbers (0.5, 1, 10) read better than powers of ten for errors in degrees
+        ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
     if hue:
         ax.legend(title="trial", fontsize=8, frameon=False)
     ax.grid(axis="y", alpha=0.3)

@@ -304,6 +304,7 @@ def tilt_overview(
         trajectory=g,
         traj_kw={"color": "c", "lw": 0.4, "alpha": 0.6} | (traj_kw or {}),
     )
+    ax3.set_box_aspect((1, 1, 1), zoom=1.25)  # the sphere fills its panel
     name = ("log10 " if log else "") + tmap[quantity].attrs.get("long_name", quantity)
     ax3.set_title(f"(a) {name} per facet and trajectory", fontsize=9)
     ax = map_axes(fig, 122)
@@ -594,6 +595,14 @@ def tilt_points_map(
         labels={} if baseline is not None else None,
     )
     legend_if_many(ax, loc="upper center", bbox_to_anchor=(0.5, -0.02), frameon=False)
+    ax.text(
+        0.02,
+        0.02,
+        f"grid: {grid_step_deg:g}° steps",
+        transform=ax.transAxes,
+        fontsize=8,
+        color="0.3",
+    )
     if title:
         ax.set_title(title, fontsize=9)
     return ax
@@ -675,15 +684,18 @@ def residence_figure(
         sample index to seconds first).
     cmap : str or Colormap
     figsize : (float, float), optional
-        Default 2.8 in per panel (8.4 in, the book's column, for three panels).
+        Default: two maps side by side, 8.4 in (the book's column) wide; with ``series``
+        the trajectory panel spans the column below them.
     panel_titles : (str, str)
 
     Returns
     -------
     matplotlib.figure.Figure
     """
-    n = 3 if series is not None else 2
-    fig = plt.figure(figsize=figsize or (MAX_WIDTH_IN / 3 * n, 3.4))
+    rows = 2 if series is not None else 1
+    fig = plt.figure(figsize=figsize or (MAX_WIDTH_IN, 3.6 + 2.6 * (rows - 1)))
+    heights = [3.6, 2.6][:rows]
+    gs = fig.add_gridspec(rows, 2, height_ratios=heights)
     visited = res.n_visits > 0
     for j, (name, v, u) in enumerate(
         [
@@ -691,7 +703,7 @@ def residence_figure(
             (panel_titles[1], res.mean_residence, "s"),
         ]
     ):
-        ax = map_axes(fig, (1, n, j + 1))
+        ax = map_axes(fig, gs[0, j])
         facet_map(
             np.where(visited, v, np.nan),
             mesh,
@@ -704,14 +716,19 @@ def residence_figure(
         )
     if series is not None:
         t, rt, nv = series
-        ax = fig.add_subplot(1, n, 3)
-        ax.plot(t, rt, lw=0.8, label="RT(i) (s)")
-        ax.plot(t, nv, lw=0.8, label="NV(i) (visits)")
-        ax.set(
-            xlabel=label("time", "s"),
-            ylabel=label("RT (s) / NV", None),
-            title="App. C along the trajectory",
+        ax = fig.add_subplot(gs[1, :])
+        ax.plot(t, rt, lw=0.8, label="RT(i): residence time (s)")
+        ax.plot(t, nv, lw=0.8, label="NV(i): number of visits")
+        ax.set(xlabel=label("time", "s"), ylabel=label("RT (s) / NV", None))
+        ax.set_title(
+            "along the trajectory (cap centred on the current sample)", fontsize=9
         )
-        ax.legend(fontsize=8)
+        ax.legend(
+            fontsize=8,
+            ncols=2,
+            loc="lower center",
+            bbox_to_anchor=(0.5, 1.08),
+            frameon=False,
+        )
     fig.tight_layout()
     return fig
