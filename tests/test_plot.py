@@ -140,8 +140,19 @@ def test_score_heatmap_and_curves():
         attrs={"units": "deg"},
     )
     ax = plot.score_heatmap(s, log=True)
-    assert has_colorbar(ax) and ax.get_xlabel() == "ki" and ax.get_ylabel() == "kp"
-    assert ax.images[0].colorbar.ax.get_ylabel() == "log10 mean error (°)"
+    # parameter axes carry the filters' parameter units; the log colour bar plain numbers
+    assert has_colorbar(ax) and ax.get_xlabel() == "ki (rad/s²)"
+    assert ax.get_ylabel() == "kp (rad/s)"
+    cbar = ax.images[0].colorbar
+    assert cbar.ax.get_ylabel() == "mean error (°), log scale"
+    ax.figure.canvas.draw()
+    labels = [t.get_text() for t in cbar.ax.get_yticklabels() if t.get_text()]
+    assert labels and all("10^" not in t and "$" not in t for t in labels), labels
+    s_units = s.assign_coords(kp=s["kp"].assign_attrs(units="1/s"))
+    ax = plot.score_heatmap(s_units, param_units={})
+    assert ax.get_ylabel() == "kp (1/s)" and ax.get_xlabel() == "ki"
+    with pytest.raises(ValueError, match="positive"):
+        plot.score_heatmap(s - 5, log=True)
     assert [t.get_text() for t in ax.get_xticklabels()] == ["0", "0.01", "0.1", "1"]
     ax = plot.score_curves(s, "kp", hue="ki")
     assert (

@@ -153,13 +153,14 @@ from .lowpass import lowpass_tilt
 from .madgwick import madgwick, madgwick_batch
 from .mahony import mahony
 from .recordings import Inputs, estimate, gravity, prepare, run
-from .registry import METHODS, Method, defaults, get_method, methods
+from .registry import METHODS, PARAMETER_UNITS, Method, defaults, get_method, methods
 from .rts import rts_smoother
 from .smoothers import rest_gyro_bias, smoother
 from .vectors import davenport, magnetic_dip
 
 __all__ = [
     "METHODS",
+    "PARAMETER_UNITS",
     "Method",
     "methods",
     "get_method",

@@ -35,7 +35,31 @@ from .mahony import mahony
 from .rts import rts_smoother
 from .smoothers import smoother
 
-__all__ = ["Method", "METHODS", "methods", "get_method", "defaults"]
+__all__ = [
+    "Method",
+    "METHODS",
+    "PARAMETER_UNITS",
+    "methods",
+    "get_method",
+    "defaults",
+]
+
+#: units of the tunable parameters, as the filters' docstrings state them ("1": unitless);
+#: figure recipes label parameter axes with them
+PARAMETER_UNITS: Mapping[str, str] = MappingProxyType(
+    {
+        "beta": "rad/s",
+        "kp": "rad/s",
+        "ki": "rad/s²",
+        "var_gyr": "(rad/s)²",
+        "var_acc": "1",
+        "var_mag": "1",
+        "cutoff_hz": "Hz",
+        "tau_acc_s": "s",
+        "gyr_noise": "rad/√s",
+        "acc_noise": "m/s/√s",
+    }
+)
 
 #: keyword arguments that are never parameters of :func:`estimate`
 _NOT_PARAMS = frozenset({"mag", "return_bias", "return_state"})

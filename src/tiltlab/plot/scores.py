@@ -37,6 +37,7 @@ def score_heatmap(
     mark_best: bool = True,
     cmap="viridis",
     title: str | None = None,
+    param_units: Mapping[str, str] | None = None,
 ):
     """Heat map of a score over a two-parameter grid, with the best cell circled and a colour bar.
 
@@ -48,7 +49,8 @@ def score_heatmap(
         second on x; coordinate values label the ticks.
     ax : matplotlib.axes.Axes, optional
     log : bool
-        Colour by log10 of the score.
+        Colour on a logarithmic scale; the colour bar is labelled with plain numbers in
+        the score's units.
     name : str
         What the score is (colour-bar label).
     units : str, optional
@@ -57,18 +59,28 @@ def score_heatmap(
         Circle the minimum.
     cmap : str or Colormap
     title : str, optional
+    param_units : mapping, optional
+        Units of the parameters on the axes (a coordinate's ``attrs['units']`` wins);
+        default :data:`tiltlab.filters.PARAMETER_UNITS`.
 
     Returns
     -------
     matplotlib.axes.Axes
     """
+    from matplotlib.colors import LogNorm
+
+    from ..filters import PARAMETER_UNITS
+    from .filters import plain_log_ticks
+
     if not isinstance(scores, xr.DataArray) or scores.ndim != 2:
         raise ValueError("scores must be a 2-D DataArray (two parameters)")
     ax = new_axes(ax, figsize=(4.5, 3.5))
     a, b = scores.dims
     v = np.asarray(scores.values, float)
-    shown = np.log10(v) if log else v
-    im = ax.imshow(shown, origin="lower", cmap=cmap, aspect="auto")
+    if log and not (v[np.isfinite(v)] > 0).all():
+        raise ValueError("log=True needs positive scores")
+    norm = LogNorm(np.nanmin(v), np.nanmax(v)) if log else None
+    im = ax.imshow(v, origin="lower", cmap=cmap, aspect="auto", norm=norm)
     ax.set_xticks(
         range(scores.sizes[b]),
         [_fmt(x) for x in scores[b].values] if b in scores.coords else None,
@@ -77,13 +89,19 @@ def score_heatmap(
         range(scores.sizes[a]),
         [_fmt(x) for x in scores[a].values] if a in scores.coords else None,
     )
-    ax.set_xlabel(b)
-    ax.set_ylabel(a)
+    units_by_name = PARAMETER_UNITS if param_units is None else param_units
+    for dim, set_label in ((b, ax.set_xlabel), (a, ax.set_ylabel)):
+        attrs = scores[dim].attrs if dim in scores.coords else {}
+        set_label(label(dim, attrs.get("units", units_by_name.get(dim))))
     if mark_best and np.isfinite(v).any():
         i, j = np.unravel_index(int(np.nanargmin(v)), v.shape)
         ax.plot(j, i, "o", mfc="none", mec="w", ms=14, mew=2, label="best")
     u = units or units_of(scores, "deg")
-    ax.figure.colorbar(im, ax=ax, label=label(("log10 " if log else "") + name, u))
+    cbar = ax.figure.colorbar(
+        im, ax=ax, label=label(name, u) + (", log scale" if log else "")
+    )
+    if log:
+        plain_log_ticks(cbar.ax, "y")
     if title:
         ax.set_title(title)
     return ax
