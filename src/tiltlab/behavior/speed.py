@@ -129,7 +129,9 @@ def speed_modes(
     dict
         ``still_mode``, ``valley``, ``moving_mode`` (°/s) and ``depth`` (smoothed height
         of the valley over that of the lower mode); all NaN when the distribution has no
-        second mode.
+        second mode. The modes and the valley are bin centres, so they are resolved to
+        one bin, ``(log_range[1] - log_range[0]) / bins`` decades (0.0375 decade, 9 %,
+        by default): two similar distributions can report the same value.
     """
     lo_hi = _v.vectors(log_range, "log_range", width=2, ndim=1)
     if lo_hi[0] >= lo_hi[1]:

@@ -247,7 +247,8 @@ def series_panels(
             ax.set_yscale("log")
         if ylim and name in ylim:
             ax.set_ylim(*ylim[name])
-        legend_if_many(ax, ncol=min(3, len(lines)))
+        # beside the panel, never on the data
+        legend_if_many(ax, loc="upper left", bbox_to_anchor=(1.005, 1.0), frameon=False)
     axes[-1, 0].set_xlabel(label(xlabel, xunits))
     if title:
         axes[0, 0].set_title(title)
