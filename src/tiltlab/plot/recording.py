@@ -35,6 +35,27 @@ __all__ = [
 
 _AXIS_COLOURS = AXIS_COLOURS
 
+
+def _thicken(legend, lw: float = 2.0):
+    """Widen the line samples of a legend so that thin data lines stay identifiable.
+
+    Parameters
+    ----------
+    legend : matplotlib.legend.Legend or None
+        The legend (``None`` is ignored).
+    lw : float
+        Minimum line width (points) of its line samples.
+
+    Returns
+    -------
+    matplotlib.legend.Legend or None
+    """
+    if legend is not None:
+        for line in legend.get_lines():
+            line.set_linewidth(max(lw, line.get_linewidth()))
+    return legend
+
+
 #: Default width (inches) of the full-width figures: the book's column at 100 dpi.
 FIG_WIDTH = 8.4
 
@@ -162,8 +183,10 @@ def plot_recording(
         )
         if shade is not None:
             shade_mask(ax, t, sel[shade].values, label=shade_label or shade)
-        ax.legend(
-            loc="upper left", bbox_to_anchor=(1.005, 1.0), fontsize=8, frameon=False
+        _thicken(
+            ax.legend(
+                loc="upper left", bbox_to_anchor=(1.005, 1.0), fontsize=8, frameon=False
+            )
         )
     axes[-1, 0].set_xlabel(label("time", "s"))
     if title:
@@ -249,6 +272,7 @@ def series_panels(
             ax.set_ylim(*ylim[name])
         # beside the panel, never on the data
         legend_if_many(ax, loc="upper left", bbox_to_anchor=(1.005, 1.0), frameon=False)
+        _thicken(ax.get_legend())
     axes[-1, 0].set_xlabel(label(xlabel, xunits))
     if title:
         axes[0, 0].set_title(title)
@@ -328,6 +352,7 @@ def speed_trace(
     ax.set_xlabel(label("time", "s"))
     ax.set_ylabel(label("angular speed", u))
     legend_if_many(ax, loc="upper right")
+    _thicken(ax.get_legend())
     return ax
 
 
