@@ -21,10 +21,13 @@ __all__ = ["score_heatmap", "score_curves", "trial_bars", "ecdf_plot", "binned_e
 
 
 def _fmt(v) -> str:
+    """A tick label as a plain number (``0.00001``, not ``1e-05``)."""
     try:
-        return f"{float(v):g}"
+        x = float(v)
     except (TypeError, ValueError):
         return str(v)
+    s = f"{x:g}"
+    return np.format_float_positional(x, trim="-") if "e" in s else s
 
 
 def score_heatmap(
@@ -61,7 +64,9 @@ def score_heatmap(
     title : str, optional
     param_units : mapping, optional
         Units of the parameters on the axes (a coordinate's ``attrs['units']`` wins);
-        default :data:`tiltlab.filters.PARAMETER_UNITS`.
+        default :data:`tiltlab.filters.PARAMETER_UNITS`; a dimensionless one (``"1"``)
+        is labelled "(unitless)". Tick labels are plain numbers (``0.00001``, never
+        ``1e-05``).
 
     Returns
     -------
@@ -92,7 +97,9 @@ def score_heatmap(
     units_by_name = PARAMETER_UNITS if param_units is None else param_units
     for dim, set_label in ((b, ax.set_xlabel), (a, ax.set_ylabel)):
         attrs = scores[dim].attrs if dim in scores.coords else {}
-        set_label(label(dim, attrs.get("units", units_by_name.get(dim))))
+        u = attrs.get("units", units_by_name.get(dim))
+        # a dimensionless parameter says so rather than showing no unit at all
+        set_label(f"{dim} (unitless)" if u == "1" else label(dim, u))
     if mark_best and np.isfinite(v).any():
         i, j = np.unravel_index(int(np.nanargmin(v)), v.shape)
         ax.plot(j, i, "o", mfc="none", mec="w", ms=14, mew=2, label="best")
@@ -277,7 +284,7 @@ def ecdf_plot(
         ax.set_xscale("log")
     ax.set_xlabel(label(name, units or units_of(next(iter(errors.values())), "deg")))
     ax.set_ylabel("cumulative fraction")
-    legend_if_many(ax, fontsize=7)
+    legend_if_many(ax, fontsize=8)
     if title:
         ax.set_title(title)
     return ax
@@ -329,7 +336,7 @@ def binned_errors(
         ax.set_yscale("log")
     ax.set_xlabel(label(xname, xunits))
     ax.set_ylabel(label(name, units))
-    legend_if_many(ax, fontsize=7)
+    legend_if_many(ax, fontsize=8)
     if title:
         ax.set_title(title)
     return ax
