@@ -10,7 +10,7 @@ from collections.abc import Mapping, Sequence
 
 import matplotlib.pyplot as plt
 import numpy as np
-from matplotlib.ticker import FuncFormatter, MaxNLocator
+from matplotlib.ticker import FuncFormatter, LogLocator, MaxNLocator
 import pandas as pd
 
 from ._common import label, new_axes
@@ -110,7 +110,13 @@ def method_strips(
             )
         if len(rows):
             med = float(np.median(rows[metric]))
-            ax.plot([i - 0.3, i + 0.3], [med, med], color="k", lw=2)
+            ax.plot(
+                [i - 0.3, i + 0.3],
+                [med, med],
+                color="k",
+                lw=2,
+                label="median, all trials" if i == 0 else None,
+            )
     ax.set_xticks(range(len(methods)), methods, rotation=20, ha="right")
     ax.set_ylabel(
         label(f"{metric} RMSE per trial" + (", log scale" if logy else ""), "deg")
@@ -118,8 +124,11 @@ def method_strips(
     if logy:
         ax.set_yscale("log")
         # plain numbers (0.5, 1, 10) read better than powers of ten for errors in degrees
+        # and a 1-3-10 sequence labels every decade the dots span, not only 1 and 10
+        ax.yaxis.set_major_locator(LogLocator(base=10, subs=(1.0, 3.0)))
+        ax.yaxis.set_minor_locator(LogLocator(base=10, subs=(2.0, 5.0)))
         ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
-    if hue:
-        ax.legend(title="trial", fontsize=8, frameon=False)
+        ax.yaxis.set_minor_formatter(FuncFormatter(lambda v, _: ""))
+    ax.legend(title="trial" if hue else None, fontsize=8, frameon=False)
     ax.grid(axis="y", alpha=0.3)
     return ax

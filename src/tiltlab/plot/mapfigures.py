@@ -723,12 +723,7 @@ def residence_figure(
         ax.set_title(
             "along the trajectory (cap centred on the current sample)", fontsize=9
         )
-        ax.legend(
-            fontsize=8,
-            ncols=2,
-            loc="lower center",
-            bbox_to_anchor=(0.5, 1.08),
-            frameon=False,
-        )
+        # inside the panel, so that it does not sit between the maps and the title
+        ax.legend(fontsize=8, loc="upper left", frameon=False)
     fig.tight_layout()
     return fig
