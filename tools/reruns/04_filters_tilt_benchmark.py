@@ -39,9 +39,8 @@ def check(nb_path: Path, params: dict) -> str:
     found = printed(
         nb_path,
         r"madgwick with default parameters \(beta = [0-9.]+\): tilt RMSE ([0-9.]+) deg",
+        "Madgwick error for SOURCE",
     )
-    if not found:
-        raise AssertionError("the chapter printed no Madgwick error for SOURCE")
     rec = datasets.load(params["SOURCE"])
     expected = evaluate.tilt_rmse(filters.estimate(rec, "madgwick"), rec)
     got = float(found[0])

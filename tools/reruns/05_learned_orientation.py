@@ -20,10 +20,10 @@ def check(nb_path: Path, params: dict) -> str:
     from tiltlab import datasets, evaluate, learn
 
     found = printed(
-        nb_path, r"compared (\d+) methods on (\d+) held-out trials:\n([0-9,\s]*)"
+        nb_path,
+        r"compared (\d+) methods on (\d+) held-out trials:\n([0-9,\s]*)",
+        "comparison line",
     )
-    if not found:
-        raise AssertionError("the chapter printed no comparison line")
     n_methods, _, listed = found[0]
     trials = sorted(int(t) for t in listed.split(",") if t.strip())
     if trials != sorted(params["TRIALS"]):
@@ -31,9 +31,11 @@ def check(nb_path: Path, params: dict) -> str:
             f"chapter compared trials {trials}, asked {params['TRIALS']}"
         )
 
-    got = printed(nb_path, r"against the reference: inclination RMSE ([0-9.]+) deg")
-    if not got:
-        raise AssertionError("the chapter printed no error for SOURCE (§6)")
+    got = printed(
+        nb_path,
+        r"against the reference: inclination RMSE ([0-9.]+) deg",
+        "error for SOURCE (§6)",
+    )
     trial = int(params["SOURCE"].split(":")[1])
     folds = json.loads((MODELS / "run.json").read_text())["folds"]
     fold = next(k for k, f in enumerate(folds) if trial in f)

@@ -50,9 +50,8 @@ def check(nb_path: Path, params: dict) -> str:
         nb_path,
         r"Computed (\d+) tables \((\d+) tests\) for (\d+) features, (\d+) groups, "
         r"(\d+) time points after",
+        "table summary line",
     )
-    if not found:
-        raise AssertionError("the chapter printed no table summary line")
     tables, tests, n_features, groups, post = map(int, found[0])
     if (groups, post) != (n_groups, n_post):
         raise AssertionError(
@@ -68,9 +67,8 @@ def check(nb_path: Path, params: dict) -> str:
     lines = printed(
         nb_path,
         r"(\S+) (\S+): max \|ω_z\(gravity\) − ω·g\| = \S+ °/s; circling index ([-+0-9.]+) /min",
+        "circling index (§4)",
     )
-    if not lines:
-        raise AssertionError("the chapter printed no circling index (§4)")
     subject, timepoint, index = lines[0]
     table = cohort.read_manifest(params["COHORT_MANIFEST"])
     rows = table.table

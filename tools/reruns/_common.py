@@ -7,8 +7,10 @@ import re
 from pathlib import Path
 
 
-def printed(nb_path: Path, pattern: str) -> list[str]:
-    """All matches of ``pattern`` (one group) in the executed notebook's stream outputs."""
+def printed(nb_path: Path, pattern: str, what: str) -> list:
+    """All matches of ``pattern`` in the executed notebook's stream outputs (strings,
+    or tuples for several groups); an ``AssertionError`` saying that the chapter
+    printed no ``what`` when there is none."""
     nb = json.loads(nb_path.read_text())
     text = "".join(
         "".join(o.get("text", ""))
@@ -17,4 +19,7 @@ def printed(nb_path: Path, pattern: str) -> list[str]:
         for o in c.get("outputs", [])
         if o.get("output_type") == "stream"
     )
-    return re.findall(pattern, text)
+    found = re.findall(pattern, text)
+    if not found:
+        raise AssertionError(f"the chapter printed no {what}")
+    return found
