@@ -1,0 +1,100 @@
+"""Shared pieces of the readers: the error type and the checked table reader."""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+PathLike = str | os.PathLike
+
+
+class ReadError(OSError):
+    """A file is missing, truncated, corrupt or not in the expected layout."""
+
+
+def _missing_columns_message(
+    path: Path,
+    df: pd.DataFrame,
+    missing: Sequence[str],
+    roles: Mapping[str, str] | None,
+) -> str:
+    import difflib
+
+    found = [str(c) for c in df.columns]
+    parts = []
+    for c in missing:
+        role = (roles or {}).get(c)
+        if role == "time_column":
+            role = " (time_column)"
+        elif role is not None:
+            role = f" (mapped to {role})"
+        else:
+            role = ""
+        folded = {f.strip().lower(): f for f in found}
+        close = difflib.get_close_matches(str(c).strip().lower(), folded, 1, 0.6)
+        hint = f", did you mean {folded[close[0]]!r}?" if close else ""
+        parts.append(f"{c!r}{role}{hint}")
+    msg = (
+        f"{path}: missing column(s) {'; '.join(parts)}; "
+        f"available columns: {', '.join(repr(c) for c in found)}"
+    )
+    if len(found) == 1 and any(sep in found[0] for sep in ";\t|, "):
+        msg += " (one column only: is the separator right? give sep, e.g. sep=';')"
+    return msg
+
+
+def _read_table(
+    path: PathLike,
+    required: Sequence[str],
+    *,
+    final_newline: bool = False,
+    roles: Mapping[str, str] | None = None,
+    **kwargs,
+) -> pd.DataFrame:
+    path = Path(path)
+    if not path.is_file():
+        raise ReadError(f"{path}: no such file")
+    if final_newline:
+        # files written line by line end with a newline; a missing one means the copy was cut short
+        with open(path, "rb") as f:
+            f.seek(0, os.SEEK_END)
+            if f.tell() == 0:
+                raise ReadError(f"{path}: empty file")
+            f.seek(-1, os.SEEK_END)
+            if f.read(1) not in (b"\n", b"\r"):
+                raise ReadError(
+                    f"{path}: last line is incomplete (no final newline): truncated file?"
+                )
+    try:
+        df = pd.read_csv(path, **kwargs)
+    except (
+        pd.errors.ParserError,
+        pd.errors.EmptyDataError,
+        UnicodeDecodeError,
+        ValueError,
+        TypeError,
+    ) as exc:
+        raise ReadError(f"{path}: not a readable CSV table ({exc})") from None
+    missing = [c for c in required if c not in df.columns]
+    if missing:
+        raise ReadError(_missing_columns_message(path, df, missing, roles))
+    sub = df[list(required)]
+    numeric = sub.apply(pd.to_numeric, errors="coerce")
+    bad = numeric.isna() & ~sub.isna()
+    if bad.to_numpy().any():
+        row, col = np.argwhere(bad.to_numpy())[0]
+        raise ReadError(
+            f"{path}: non-numeric value {sub.iat[row, col]!r} in column {required[col]!r}, data row {row}"
+        )
+    if numeric.isna().to_numpy().any():
+        row, col = np.argwhere(numeric.isna().to_numpy())[0]
+        raise ReadError(
+            f"{path}: empty field in column {required[col]!r}, data row {row} (truncated file?)"
+        )
+    if len(numeric) < 2:
+        raise ReadError(f"{path}: fewer than two samples")
+    return numeric

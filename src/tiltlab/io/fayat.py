@@ -1,0 +1,97 @@
+"""Fayat et al. 2021 CSV files: the freely-moving example and the tumble test."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import xarray as xr
+
+from .. import _validate, schema
+from ._common import PathLike, _read_table
+
+
+def read_fayat_imu(
+    path: PathLike, *, counter_rate: float = 300.0, fs: float = 100.0, **attrs
+) -> xr.Dataset:
+    """Read Fayat et al.'s freely-moving rat example (``example_imu.csv``).
+
+    Columns ``counter, ax, ay, az, gx, gy, gz``: acceleration in g, angular velocity in
+    °/s, ``counter`` the acquisition board's sample counter at ``counter_rate`` Hz. The
+    file is down-sampled to ``fs`` = 100 Hz, so sample times are ``(counter − counter₀) /
+    counter_rate``; 27 of its intervals are 2/300 s instead of 3/300 s (left as they are,
+    and kept in the ``counter`` variable).
+
+    Axes: x points forward (nose), y to the animal's left, z up (dorsal) [1]_.
+
+    References
+    ----------
+    .. [1] R. Fayat et al., Sensors 21(18):6318, 2021. doi:10.3390/s21186318
+    """
+    df = _read_table(
+        path, ["counter", "ax", "ay", "az", "gx", "gy", "gz"], final_newline=True
+    )
+    counter_rate = _validate.positive(counter_rate, "counter_rate")
+    counter = df["counter"].to_numpy(np.int64)
+    time = (counter - counter[0]) / counter_rate
+    return schema.make_recording(
+        df[["ax", "ay", "az"]].to_numpy(),
+        df[["gx", "gy", "gz"]].to_numpy(),
+        fs,
+        acc_units="g",
+        gyr_units="deg/s",
+        time=time,
+        extra={
+            "counter": (
+                "time",
+                counter,
+                {"long_name": f"acquisition counter at {counter_rate:g} Hz"},
+            )
+        },
+        attrs={
+            "source": str(Path(path).name),
+            "sensor": "MPU9250 (wired head IMU)",
+            "subject": "rat",
+            "session": "example",
+            "axes": "x forward (nose), y left, z up (dorsal)",
+            **attrs,
+        },
+    )
+
+
+def read_fayat_tumble(path: PathLike, *, fs: float = 300.0, **attrs) -> xr.Dataset:
+    """Read Fayat et al.'s tumble-test recording (``example_sensor_calibration.csv``).
+
+    Columns: an unnamed index, ``ax, ay, az`` (g), ``gx, gy, gz`` (°/s), ``time`` (s);
+    300 Hz. The sensor is held still in several orientations; there is no trigger
+    channel.
+
+    The MPU9250 was set to ±4 g and ±1000 °/s: every value is a multiple of 1/8192 g and
+    1/32.768 °/s, and the file holds the rails −4 g, 32767/8192 g and −1000 °/s. Both are
+    recorded as the variables' ``range`` attribute (the full scale), so that the samples
+    clipped while the sensor was turned over are found
+    (:func:`tiltlab.quality.saturation`).
+    """
+    df = _read_table(
+        path,
+        ["ax", "ay", "az", "gx", "gy", "gz", "time"],
+        final_newline=True,
+        index_col=0,
+    )
+    return schema.make_recording(
+        df[["ax", "ay", "az"]].to_numpy(),
+        df[["gx", "gy", "gz"]].to_numpy(),
+        fs,
+        acc_units="g",
+        gyr_units="deg/s",
+        acc_range=4.0,
+        gyr_range=1000.0,
+        time=df["time"].to_numpy(),
+        attrs={
+            "source": str(Path(path).name),
+            "sensor": "MPU9250",
+            "subject": "none",
+            "session": "tumble test",
+            **attrs,
+        },
+    )
