@@ -72,8 +72,17 @@ MAG = np.column_stack(
         -np.sin(_theta) * _mw[1] + np.cos(_theta) * _mw[2],
     ]
 )
-REC = schema.make_recording(ACC, GYR, FS, mag=MAG, attrs={"session": "s1"})
-REC6 = schema.make_recording(ACC, GYR, FS)
+REC = schema.make_recording(
+    ACC,
+    GYR,
+    FS,
+    mag=MAG,
+    attrs={"session": "s1"},
+    acc_units="g",
+    gyr_units="deg/s",
+    mag_units="uT",
+)
+REC6 = schema.make_recording(ACC, GYR, FS, acc_units="g", gyr_units="deg/s")
 Q = filters.estimate(REC6, "lowpass").values
 G = quaternion.gravity(Q)  # unit tilt vectors
 RNG = np.random.default_rng(0)
@@ -162,145 +171,190 @@ def case(id_, call, exc, match, owner: str | None = None, strict: bool = True):
 # ----------------------------------------------------------------------------- schema
 case(
     "schema-fs-none",
-    lambda t: schema.make_recording(ACC, GYR, None),
+    lambda t: schema.make_recording(ACC, GYR, None, acc_units="g", gyr_units="deg/s"),
     ValueError,
     r"\bfs\b",
 )
 case(
     "schema-fs-zero",
-    lambda t: schema.make_recording(ACC, GYR, 0),
+    lambda t: schema.make_recording(ACC, GYR, 0, acc_units="g", gyr_units="deg/s"),
     ValueError,
     r"\bfs\b.*\b0",
 )
 case(
     "schema-fs-negative",
-    lambda t: schema.make_recording(ACC, GYR, -100),
+    lambda t: schema.make_recording(ACC, GYR, -100, acc_units="g", gyr_units="deg/s"),
     ValueError,
     r"\bfs\b.*-100",
 )
 case(
     "schema-fs-nan",
-    lambda t: schema.make_recording(ACC, GYR, NAN),
+    lambda t: schema.make_recording(ACC, GYR, NAN, acc_units="g", gyr_units="deg/s"),
     ValueError,
     r"\bfs\b.*nan",
 )
 case(
     "schema-fs-inf",
-    lambda t: schema.make_recording(ACC, GYR, INF),
+    lambda t: schema.make_recording(ACC, GYR, INF, acc_units="g", gyr_units="deg/s"),
     ValueError,
     r"\bfs\b.*inf",
 )
 case(
     "schema-fs-string",
-    lambda t: schema.make_recording(ACC, GYR, "fast"),
+    lambda t: schema.make_recording(ACC, GYR, "fast", acc_units="g", gyr_units="deg/s"),
     ValueError,
     r"\bfs\b.*fast",
 )
 case(
     "schema-acc-shape",
-    lambda t: schema.make_recording(ACC[:, :2], GYR, FS),
+    lambda t: schema.make_recording(
+        ACC[:, :2], GYR, FS, acc_units="g", gyr_units="deg/s"
+    ),
     RecordingError,
     r"\bacc\b.*shape",
 )
 case(
     "schema-gyr-1d",
-    lambda t: schema.make_recording(ACC, GYR[:, 0], FS),
+    lambda t: schema.make_recording(
+        ACC, GYR[:, 0], FS, acc_units="g", gyr_units="deg/s"
+    ),
     RecordingError,
     r"\bgyr\b.*shape",
 )
 case(
     "schema-length-mismatch",
-    lambda t: schema.make_recording(ACC, GYR[:-1], FS),
+    lambda t: schema.make_recording(
+        ACC, GYR[:-1], FS, acc_units="g", gyr_units="deg/s"
+    ),
     RecordingError,
     r"acc and gyr",
 )
 case(
     "schema-acc-nan",
-    lambda t: schema.make_recording(np.where(ACC > 0.99, NAN, ACC), GYR, FS),
+    lambda t: schema.make_recording(
+        np.where(ACC > 0.99, NAN, ACC), GYR, FS, acc_units="g", gyr_units="deg/s"
+    ),
     RecordingError,
     r"\bacc\b.*non-finite",
 )
 case(
     "schema-gyr-inf",
-    lambda t: schema.make_recording(ACC, np.where(GYR > 40, INF, GYR), FS),
+    lambda t: schema.make_recording(
+        ACC, np.where(GYR > 40, INF, GYR), FS, acc_units="g", gyr_units="deg/s"
+    ),
     RecordingError,
     r"\bgyr\b.*non-finite",
 )
 case(
     "schema-acc-units-unknown",
-    lambda t: schema.make_recording(ACC, GYR, FS, acc_units="furlong"),
+    lambda t: schema.make_recording(
+        ACC, GYR, FS, acc_units="furlong", gyr_units="deg/s"
+    ),
     ValueError,
     r"furlong",
 )
 case(
     "schema-gyr-units-wrong-quantity",
-    lambda t: schema.make_recording(ACC, GYR, FS, gyr_units="g"),
+    lambda t: schema.make_recording(ACC, GYR, FS, gyr_units="g", acc_units="g"),
     RecordingError,
     r"\bgyr\b.*units",
 )
 case(
     "schema-gyr-units-implausible",
-    lambda t: schema.make_recording(ACC, np.radians(GYR), FS),
+    lambda t: schema.make_recording(
+        ACC, np.radians(GYR), FS, acc_units="g", gyr_units="deg/s"
+    ),
     RecordingError,
     r"\bgyr\b.*(units|rad/s)",
 )
 case(
     "schema-time-shape",
-    lambda t: schema.make_recording(ACC, GYR, FS, time=_t[:-1]),
+    lambda t: schema.make_recording(
+        ACC, GYR, FS, time=_t[:-1], acc_units="g", gyr_units="deg/s"
+    ),
     RecordingError,
     r"\btime\b.*shape",
 )
 case(
     "schema-time-decreasing",
-    lambda t: schema.make_recording(ACC, GYR, FS, time=_t[::-1]),
+    lambda t: schema.make_recording(
+        ACC, GYR, FS, time=_t[::-1], acc_units="g", gyr_units="deg/s"
+    ),
     RecordingError,
     r"\btime\b.*increasing",
 )
 case(
     "schema-time-contradicts-fs",
-    lambda t: schema.make_recording(ACC, GYR, 2 * FS, time=_t),
+    lambda t: schema.make_recording(
+        ACC, GYR, 2 * FS, time=_t, acc_units="g", gyr_units="deg/s"
+    ),
     RecordingError,
     r"time is irregular|fs",
 )
 case(
     "schema-t0-nan",
-    lambda t: schema.make_recording(ACC, GYR, FS, t0=NAN),
+    lambda t: schema.make_recording(
+        ACC, GYR, FS, t0=NAN, acc_units="g", gyr_units="deg/s"
+    ),
     RecordingError,
     r"\bt0\b|time",
 )
 case(
     "schema-q_ref-non-unit",
-    lambda t: schema.make_recording(ACC, GYR, FS, q_ref=2 * Q),
+    lambda t: schema.make_recording(
+        ACC, GYR, FS, q_ref=2 * Q, acc_units="g", gyr_units="deg/s"
+    ),
     RecordingError,
     r"q_ref.*non-unit",
 )
 case(
     "schema-q_ref-shape",
-    lambda t: schema.make_recording(ACC, GYR, FS, q_ref=Q[:, :3]),
+    lambda t: schema.make_recording(
+        ACC, GYR, FS, q_ref=Q[:, :3], acc_units="g", gyr_units="deg/s"
+    ),
     ValueError,
     r"q_ref",
 )
 case(
     "schema-mag-shape",
-    lambda t: schema.make_recording(ACC, GYR, FS, mag=MAG[:, :2]),
+    lambda t: schema.make_recording(
+        ACC, GYR, FS, mag=MAG[:, :2], acc_units="g", gyr_units="deg/s", mag_units="uT"
+    ),
     ValueError,
     r"\bmag\b",
 )
 case(
     "schema-temp-length",
-    lambda t: schema.make_recording(ACC, GYR, FS, temp=np.zeros(N - 1)),
+    lambda t: schema.make_recording(
+        ACC,
+        GYR,
+        FS,
+        temp=np.zeros(N - 1),
+        acc_units="g",
+        gyr_units="deg/s",
+        temp_units="degC",
+    ),
     ValueError,
     r"\btemp\b",
 )
 case(
     "schema-mag-nan",
-    lambda t: schema.make_recording(ACC, GYR, FS, mag=MAG * NAN),
+    lambda t: schema.make_recording(
+        ACC, GYR, FS, mag=MAG * NAN, acc_units="g", gyr_units="deg/s", mag_units="uT"
+    ),
     RecordingError,
     r"\bmag\b.*non-finite",
 )
 case(
     "schema-extra-shape",
-    lambda t: schema.make_recording(ACC, GYR, FS, extra={"flags": np.zeros((N, 2))}),
+    lambda t: schema.make_recording(
+        ACC,
+        GYR,
+        FS,
+        extra={"flags": np.zeros((N, 2))},
+        acc_units="g",
+        gyr_units="deg/s",
+    ),
     RecordingError,
     r"flags",
 )

@@ -85,16 +85,25 @@ def test_immobility_on_recording_and_units():
     s_deg = _speed([(2.0, 1), (2.0, 60), (2.0, 1)], fs)
     gyr = np.column_stack([s_deg, 0 * s_deg, 0 * s_deg])
     acc = np.tile([0, 0, 1.0], (gyr.shape[0], 1))
-    rec_deg = schema.make_recording(acc, gyr, fs, check_units=False)
+    rec_deg = schema.make_recording(
+        acc, gyr, fs, acc_units="g", gyr_units="deg/s", check_units=False
+    )
     rec_rad = schema.make_recording(
-        acc, np.radians(gyr), fs, gyr_units="rad/s", check_units=False
+        acc, np.radians(gyr), fs, acc_units="g", gyr_units="rad/s", check_units=False
     )
     a = B.immobility(rec_deg)
     b = B.immobility(rec_rad)
     np.testing.assert_array_equal(a.values, b.values)
     assert a.sum() == 400 and a.attrs["threshold_deg_s"] == 12.0
     # an offset larger than the threshold hides every still period unless it is removed
-    biased = schema.make_recording(acc, gyr + [-20.0, 0, 0], fs, check_units=False)
+    biased = schema.make_recording(
+        acc,
+        gyr + [-20.0, 0, 0],
+        fs,
+        acc_units="g",
+        gyr_units="deg/s",
+        check_units=False,
+    )
     assert B.immobility(biased).sum() < 400
     np.testing.assert_array_equal(
         B.immobility(biased, gyr_offset=[-20.0, 0, 0]).values, a.values
@@ -353,7 +362,7 @@ def test_circling_index_reads_gyroscope_units_and_a_gravity_dataarray():
     q = Q.mul(Q.from_rotvec(np.outer(t, omega_world)), tilt)
     gyr = Q.rotate_inverse(q, omega_world)  # rad/s
     rec = schema.make_recording(
-        Q.gravity(q), gyr, fs, gyr_units="rad/s", check_units=False
+        Q.gravity(q), gyr, fs, acc_units="g", gyr_units="rad/s", check_units=False
     )
     g = filters.gravity(
         xr.DataArray(q, dims=("time", "quat"), coords={"time": rec.time.values})

@@ -540,7 +540,7 @@ def test_tumble_calibration_end_to_end():
     dirs = C.fibonacci_lattice(20)
     o = np.array([0.03, -0.05, 0.02])
     acc, gyr, _ = _tumble_record(rng, dirs, [-10.0, 5.0, 2.0], acc_offset=o)
-    rec = schema.make_recording(acc, gyr, FS)
+    rec = schema.make_recording(acc, gyr, FS, acc_units="g", gyr_units="deg/s")
     res = C.tumble_calibration(rec, model="ellipsoid")
     assert res.intervals.shape[0] == 20
     np.testing.assert_allclose(res.calibration.acc_offset, o, atol=1e-3)
@@ -557,7 +557,7 @@ def test_rad_s_gyroscope_gives_the_same_still_periods():
     same still periods as the same data in °/s."""
     rng = np.random.default_rng(21)
     acc, gyr, _ = _tumble_record(rng, C.fibonacci_lattice(8), [-12.0, 6.0, 3.0])
-    rec = schema.make_recording(acc, gyr, FS)
+    rec = schema.make_recording(acc, gyr, FS, acc_units="g", gyr_units="deg/s")
     kw = dict(threshold_deg_s=3.0, min_duration_s=0.4)
     ref = C.detect_static(gyr, FS, **kw)
     assert ref.shape[0] == 8
@@ -733,7 +733,13 @@ def test_apply_mag_calibration_is_labelled_and_fit_message_is_precise():
     rng = np.random.default_rng(26)
     m = 47.0 * Q.gravity(Q.random_quaternions(50, rng)) + [10.0, -5.0, 3.0]
     rec = schema.make_recording(
-        np.tile([0, 0, 1.0], (50, 1)), np.zeros((50, 3)), FS, mag=m
+        np.tile([0, 0, 1.0], (50, 1)),
+        np.zeros((50, 3)),
+        FS,
+        mag=m,
+        acc_units="g",
+        gyr_units="deg/s",
+        mag_units="uT",
     )
     out = C.apply_mag_calibration(rec, [10.0, -5.0, 3.0])
     assert (

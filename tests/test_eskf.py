@@ -88,6 +88,7 @@ def test_estimate_on_a_recording_equals_the_array_call(use_mag):
         acc_units="g",
         gyr_units="deg/s",
         mag=mag,
+        mag_units="uT",
     )
     qr = F.estimate(rec, "eskf", use_mag=use_mag)
     qa = F.eskf(acc, gyr, fs, mag=mag if use_mag else None)

@@ -36,6 +36,8 @@ def _rec(n=1500, fs=100.0, seed=0):
             "immobile": (("time",), immobile, {}),
             "tilt_ref": (("time", "axis"), Q.gravity(q), {"units": "1"}),
         },
+        acc_units="g",
+        gyr_units="deg/s",
     )
     return rec, q
 

@@ -351,6 +351,9 @@ def _recording(seed=0, n=1200, in_g=True):
             mag=mag,
             q_ref=q_true,
             extra={"movement": (("time",), np.ones(n, bool), {})},
+            acc_units="g",
+            gyr_units="deg/s",
+            mag_units="uT",
         )
     return make_recording(
         acc,
@@ -361,6 +364,7 @@ def _recording(seed=0, n=1200, in_g=True):
         mag=mag,
         q_ref=q_true,
         extra={"movement": (("time",), np.ones(n, bool), {})},
+        mag_units="uT",
     )
 
 

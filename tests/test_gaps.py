@@ -52,7 +52,16 @@ def _motion(n, fs=FS, rate_dps=5.0):
 
 def _recording(acc, gyr, time, mag=None):
     return make_recording(
-        acc, gyr, FS, mag=mag, time=time, max_jitter=np.inf, allow_nan=True
+        acc,
+        gyr,
+        FS,
+        mag=mag,
+        time=time,
+        max_jitter=np.inf,
+        allow_nan=True,
+        acc_units="g",
+        gyr_units="deg/s",
+        mag_units="uT",
     )
 
 
@@ -201,13 +210,25 @@ def test_empty_and_all_zero_acc_are_refused_naming_acc(method):
         m(np.zeros((n, 3)), gyr, FS)
     with pytest.raises(ValueError, match="acc"):
         m(np.full((n, 3), np.nan), gyr, FS)
-    rec = make_recording(np.zeros((n, 3)), gyr, FS, validate_result=False)
+    rec = make_recording(
+        np.zeros((n, 3)),
+        gyr,
+        FS,
+        validate_result=False,
+        acc_units="g",
+        gyr_units="deg/s",
+    )
     with pytest.raises(ValueError, match="acc"):
         F.estimate(rec, method)
     with pytest.raises(ValueError, match="acc"):
         F.estimate(rec, method, gaps="segments")
     empty = make_recording(
-        np.zeros((0, 3)), np.zeros((0, 3)), FS, validate_result=False
+        np.zeros((0, 3)),
+        np.zeros((0, 3)),
+        FS,
+        validate_result=False,
+        acc_units="g",
+        gyr_units="deg/s",
     )
     for gaps in ("raise", "segments"):
         with pytest.raises(ValueError, match="acc"):

@@ -103,7 +103,14 @@ def test_saturation_of_labelled_inputs():
     acc, gyr = moving_sensor(1000)
     gyr_clipped = np.clip(gyr, -90.0, 90.0)
     rec = schema.make_recording(
-        acc, gyr_clipped, FS, gyr_range=90.0, acc_range=16, check_saturation=False
+        acc,
+        gyr_clipped,
+        FS,
+        gyr_range=90.0,
+        acc_range=16,
+        check_saturation=False,
+        acc_units="g",
+        gyr_units="deg/s",
     )
     assert rec.gyr.attrs["range"] == 90.0 and rec.acc.attrs["range"] == 16.0
     expected = (np.abs(gyr_clipped) >= 0.999 * 90).any(axis=1)
@@ -117,7 +124,9 @@ def test_saturation_of_labelled_inputs():
     with pytest.raises(RecordingError, match="no variable 'mag'"):
         quality.saturation(rec, var="mag")
     with pytest.raises(RecordingError, match="gyr_range must be a positive full scale"):
-        schema.make_recording(acc, gyr, FS, gyr_range=-5)
+        schema.make_recording(
+            acc, gyr, FS, gyr_range=-5, acc_units="g", gyr_units="deg/s"
+        )
     bad = rec.copy()
     bad["gyr"].attrs["range"] = "huge"
     with pytest.raises(RecordingError, match="'gyr' attribute 'range'"):
@@ -131,13 +140,19 @@ def test_validate_warns_about_clipped_samples():
     with pytest.warns(
         QualityWarning, match=rf"gyr: {n_clip} of 1000 samples .* clipped"
     ):
-        rec = schema.make_recording(acc, gyr_clipped, FS, gyr_range=90.0)
+        rec = schema.make_recording(
+            acc, gyr_clipped, FS, gyr_range=90.0, acc_units="g", gyr_units="deg/s"
+        )
     # without the range attribute, the flat runs at the largest value give it away
     with pytest.warns(QualityWarning, match="its largest value, reached on runs"):
-        schema.make_recording(acc, gyr_clipped, FS)
+        schema.make_recording(acc, gyr_clipped, FS, acc_units="g", gyr_units="deg/s")
     # the check can be switched off; an unclipped recording is quiet
     quiet_validate(rec, check_saturation=False)
-    quiet_validate(schema.make_recording(acc, gyr, FS, gyr_range=2000.0))
+    quiet_validate(
+        schema.make_recording(
+            acc, gyr, FS, gyr_range=2000.0, acc_units="g", gyr_units="deg/s"
+        )
+    )
     # a full scale the data exceed is stale (e.g. units changed by hand)
     stale = rec.copy()
     stale["gyr"] = stale.gyr * (np.pi / 180) * 100
@@ -151,7 +166,15 @@ def test_validate_warns_about_clipped_samples():
 
 def test_to_units_converts_the_full_scale():
     acc, gyr = moving_sensor(500)
-    rec = schema.make_recording(acc, gyr, FS, acc_range=(-4.0, 8.0), gyr_range=2000.0)
+    rec = schema.make_recording(
+        acc,
+        gyr,
+        FS,
+        acc_range=(-4.0, 8.0),
+        gyr_range=2000.0,
+        acc_units="g",
+        gyr_units="deg/s",
+    )
     assert rec.acc.attrs["range"] == [-4.0, 8.0]
     si = schema.to_units(rec, acc="m/s^2", gyr="rad/s")
     np.testing.assert_allclose(si.acc.attrs["range"], [-4 * 9.80665, 8 * 9.80665])
@@ -168,13 +191,13 @@ def test_acc_in_m_s2_labelled_g_is_an_error_and_the_reverse():
         RecordingError,
         match=r"acc is labelled g but its median magnitude is 9\.8\d*: looks like m/s²",
     ):
-        schema.make_recording(acc * 9.80665, gyr, FS)
+        schema.make_recording(acc * 9.80665, gyr, FS, acc_units="g", gyr_units="deg/s")
     with pytest.raises(
         RecordingError,
         match=r"acc is labelled m/s² but its median magnitude is 1: looks like g",
     ):
-        schema.make_recording(acc, gyr, FS, acc_units="m/s^2")
-    schema.make_recording(acc * 9.80665, gyr, FS, acc_units="m/s^2")
+        schema.make_recording(acc, gyr, FS, acc_units="m/s^2", gyr_units="deg/s")
+    schema.make_recording(acc * 9.80665, gyr, FS, acc_units="m/s^2", gyr_units="deg/s")
     f = quality.check_acc_units(acc * 9.80665, "g")
     assert (
         f.severity == "error" and f.var == "acc" and f.value == pytest.approx(9.8, 0.02)
@@ -187,7 +210,7 @@ def test_acc_far_from_1_g_is_a_warning():
     with pytest.warns(
         QualityWarning, match=r"acc: median magnitude 0\.3 g .* far from"
     ):
-        schema.make_recording(acc * 0.3, gyr, FS)
+        schema.make_recording(acc * 0.3, gyr, FS, acc_units="g", gyr_units="deg/s")
     assert quality.check_acc_units(acc * 3.5, "g").severity == "warning"
 
 
@@ -199,7 +222,7 @@ def test_raw_counts_are_an_error():
         match=r"acc is labelled g but its median magnitude is 1\.6\d*e\+04 g .*"
         "looks like raw ADC counts: scale them to physical units first",
     ):
-        schema.make_recording(counts, gyr, FS)
+        schema.make_recording(counts, gyr, FS, acc_units="g", gyr_units="deg/s")
     f = quality.check_raw_counts(counts, "g", var="acc")
     assert f.severity == "error" and "raw ADC counts" in f.message
     # not integral: a wrong scale, still an error
@@ -207,7 +230,12 @@ def test_raw_counts_are_an_error():
     assert "far beyond any physical acceleration" in f.message
     gyr_counts = np.round(moving_sensor(600)[1] * 131.0)  # ±250 deg/s
     rec = schema.make_recording(
-        moving_sensor(600)[0], gyr_counts, FS, validate_result=False
+        moving_sensor(600)[0],
+        gyr_counts,
+        FS,
+        validate_result=False,
+        acc_units="g",
+        gyr_units="deg/s",
     )
     with pytest.raises(RecordingError, match="gyr is labelled °/s .* raw ADC counts"):
         schema.validate(rec)
@@ -221,7 +249,7 @@ def test_gyro_in_deg_s_labelled_rad_s():
         match=r"gyr is labelled rad/s but its 99th percentile magnitude is 3000 .*"
         r"beyond any MEMS gyroscope\): looks like °/s \(set units='deg/s'\)",
     ):
-        schema.make_recording(acc, fast, FS, gyr_units="rad/s")
+        schema.make_recording(acc, fast, FS, gyr_units="rad/s", acc_units="g")
     f = quality.check_gyr_units(gyr + [0, 0, 50.0], "rad/s")
     assert f.severity == "warning" and "looks like °/s" in f.message
     assert quality.check_gyr_units(gyr + [0, 0, 20.0], "rad/s") is None
@@ -235,13 +263,13 @@ def test_slow_rotation_in_rad_s_labelled_deg_s():
     acc = np.column_stack([np.sin(angle), 0 * t, np.cos(angle)])
     rate = np.full(n, (np.pi / 2) / t[-1])  # rad/s
     gyr = np.column_stack([0 * t, rate, 0 * t])
-    schema.make_recording(acc, gyr, FS, gyr_units="rad/s")
+    schema.make_recording(acc, gyr, FS, gyr_units="rad/s", acc_units="g")
     with pytest.raises(
         RecordingError,
         match=r"gyr is labelled °/s but integrates to 1\.5\d*° .* tilts by (89|90)°: "
         "looks like rad/s",
     ):
-        schema.make_recording(acc, gyr, FS, gyr_units="deg/s")
+        schema.make_recording(acc, gyr, FS, gyr_units="deg/s", acc_units="g")
     assert quality.check_gyr_units(np.degrees(gyr), "deg/s", acc=acc, fs=FS) is None
     # a still recording cannot tell
     acc0, gyr0 = still_sensor()
@@ -251,29 +279,72 @@ def test_slow_rotation_in_rad_s_labelled_deg_s():
 def test_temperature():
     acc, gyr = still_sensor()
     with pytest.raises(RecordingError, match=r"temp is labelled °C but .* look like K"):
-        schema.make_recording(acc, gyr, FS, temp=np.full(len(acc), 303.0))
+        schema.make_recording(
+            acc,
+            gyr,
+            FS,
+            temp=np.full(len(acc), 303.0),
+            acc_units="g",
+            gyr_units="deg/s",
+            temp_units="degC",
+        )
     with pytest.raises(RecordingError, match=r"temp is labelled K but .* look like °C"):
         schema.make_recording(
-            acc, gyr, FS, temp=np.full(len(acc), 30.0), temp_units="K"
+            acc,
+            gyr,
+            FS,
+            temp=np.full(len(acc), 30.0),
+            temp_units="K",
+            acc_units="g",
+            gyr_units="deg/s",
         )
     with pytest.warns(QualityWarning, match=r"temp: 1000 of 1000 values are outside"):
-        schema.make_recording(acc, gyr, FS, temp=np.full(len(acc), 120.0))
-    quiet_validate(schema.make_recording(acc, gyr, FS, temp=np.full(len(acc), 31.0)))
+        schema.make_recording(
+            acc,
+            gyr,
+            FS,
+            temp=np.full(len(acc), 120.0),
+            acc_units="g",
+            gyr_units="deg/s",
+            temp_units="degC",
+        )
     quiet_validate(
         schema.make_recording(
-            acc, gyr, FS, temp=np.full(len(acc), 304.0), temp_units="K"
+            acc,
+            gyr,
+            FS,
+            temp=np.full(len(acc), 31.0),
+            acc_units="g",
+            gyr_units="deg/s",
+            temp_units="degC",
+        )
+    )
+    quiet_validate(
+        schema.make_recording(
+            acc,
+            gyr,
+            FS,
+            temp=np.full(len(acc), 304.0),
+            temp_units="K",
+            acc_units="g",
+            gyr_units="deg/s",
         )
     )
 
 
 def test_plausibility_can_be_switched_off_and_nan_is_ignored():
     acc, gyr = moving_sensor(600)
-    rec = schema.make_recording(acc * 9.80665, gyr, FS, check_units=False)
+    rec = schema.make_recording(
+        acc * 9.80665, gyr, FS, check_units=False, acc_units="g", gyr_units="deg/s"
+    )
     assert [f.check for f in quality.assess(rec)] == ["acc_units"]
     gappy = acc.copy()
     gappy[::7] = np.nan
     quiet_validate(
-        schema.make_recording(gappy, gyr, FS, allow_nan=True), allow_nan=True
+        schema.make_recording(
+            gappy, gyr, FS, allow_nan=True, acc_units="g", gyr_units="deg/s"
+        ),
+        allow_nan=True,
     )
 
 
@@ -320,6 +391,8 @@ def test_to_units_and_extra_do_not_share_memory():
         FS,
         time=time,
         extra={"counter": ("time", counter, {"long_name": "c"}), "flags": flags},
+        acc_units="g",
+        gyr_units="deg/s",
     )
     assert not np.shares_memory(rec.counter.values, counter)
     assert not np.shares_memory(rec.flags.values, flags)
@@ -337,7 +410,13 @@ def test_to_units_and_extra_do_not_share_memory():
 def test_cli_validate_prints_warnings_and_exits_0(tmp_path, capsys):
     acc, gyr = moving_sensor(1000)
     rec = schema.make_recording(
-        acc, np.clip(gyr, -90, 90), FS, gyr_range=90.0, check_saturation=False
+        acc,
+        np.clip(gyr, -90, 90),
+        FS,
+        gyr_range=90.0,
+        check_saturation=False,
+        acc_units="g",
+        gyr_units="deg/s",
     )
     path = io.save_netcdf(rec, tmp_path / "clipped.nc")
     assert cli.main(["validate", str(path)]) == 0
@@ -353,7 +432,9 @@ def test_cli_validate_prints_warnings_and_exits_0(tmp_path, capsys):
 
 def test_cli_validate_plausibility_error_is_one_line(tmp_path, capsys):
     acc, gyr = moving_sensor(600)
-    bad = schema.make_recording(acc * 9.80665, gyr, FS, validate_result=False)
+    bad = schema.make_recording(
+        acc * 9.80665, gyr, FS, validate_result=False, acc_units="g", gyr_units="deg/s"
+    )
     path = io.save_netcdf(bad, tmp_path / "bad.nc")
     assert cli.main(["validate", str(path)]) == 1
     err = capsys.readouterr().err

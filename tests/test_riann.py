@@ -51,7 +51,13 @@ def test_mag_is_refused_6d_only():
 def test_estimate_without_mag_and_use_mag_refused():
     acc, gyr, _ = _static(seconds=2.0)
     rec = make_recording(
-        acc, gyr, FS, acc_units="m/s^2", gyr_units="rad/s", mag=np.ones_like(acc)
+        acc,
+        gyr,
+        FS,
+        acc_units="m/s^2",
+        gyr_units="rad/s",
+        mag=np.ones_like(acc),
+        mag_units="uT",
     )
     q = F.estimate(rec, "riann")  # the Recording's mag is not passed
     assert q.dims == ("time", "quat") and q.attrs["use_mag"] == 0

@@ -742,7 +742,14 @@ def _trig_recording(n=400, fs=50.0, gyr_units="deg/s", seed=0):
     if gyr_units == "rad/s":
         gyr = np.radians(gyr)
     rec = schema.make_recording(
-        acc, gyr, fs, gyr_units=gyr_units, mag=mag, check_units=False
+        acc,
+        gyr,
+        fs,
+        gyr_units=gyr_units,
+        mag=mag,
+        check_units=False,
+        acc_units="g",
+        mag_units="uT",
     )
     return rec, (th, ph, la)
 

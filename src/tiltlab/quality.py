@@ -44,6 +44,8 @@ from ._validate import RecordingError
 
 __all__ = [
     "QualityWarning",
+    "UnitCheckError",
+    "UNIT_CHECK_SWITCH",
     "Finding",
     "saturation",
     "full_scale",
@@ -61,6 +63,9 @@ __all__ = [
     "GYR_COUNTS_DEG_S",
     "MAG_COUNTS_UT",
     "GYR_RAD_S_P99",
+    "GYR_WINDOW_S",
+    "GYR_MIN_TILT_DEG",
+    "GYR_DECISIVE_SHARE",
     "TEMP_RANGE_DEGC",
 ]
 
@@ -89,6 +94,48 @@ _PRETTY = {"m/s^2": "m/s²", "deg/s": "°/s", "uT": "µT", "degC": "°C"}
 
 class QualityWarning(UserWarning):
     """Data that satisfy the Recording contract but look doubtful (e.g. clipped samples)."""
+
+
+#: The one switch that accepts unit labels as they are, in the form each entry point
+#: takes it (the error message names the one the user is using).
+UNIT_CHECK_SWITCH: dict[str, str] = {
+    "python": "check_units=False",
+    "mapping": '"check_units": false in the mapping',
+    "cli": "--no-check-units",
+    "manifest": 'reader_options {"check_units": false} in its manifest row',
+}
+
+
+class UnitCheckError(RecordingError):
+    """Values that decisively contradict their unit labels.
+
+    The message names every such variable and the unit its values look like, then the
+    switch that accepts the labels as they are, in the form of the entry point in use
+    (:data:`UNIT_CHECK_SWITCH`; :meth:`for_switch` re-words it).
+
+    Attributes
+    ----------
+    findings : tuple of Finding
+        The error findings, one per variable.
+    switch : str
+        A key of :data:`UNIT_CHECK_SWITCH`.
+    """
+
+    def __init__(self, findings: Sequence[Finding], switch: str = "python"):
+        self.findings = tuple(findings)
+        self.switch = switch if switch in UNIT_CHECK_SWITCH else "python"
+        body = "; ".join(f.message for f in self.findings)
+        super().__init__(
+            f"{body}. If the labels are right after all, "
+            f"{UNIT_CHECK_SWITCH[self.switch]} accepts them as they are"
+        )
+
+    def for_switch(self, switch: str) -> UnitCheckError:
+        """The same error, naming the switch as ``switch`` takes it."""
+        return UnitCheckError(self.findings, switch)
+
+    def __reduce__(self):  # picklable across process pools
+        return (UnitCheckError, (self.findings, self.switch))
 
 
 @dataclass(frozen=True)
@@ -542,12 +589,17 @@ def check_acc_units(acc, units: str | None = None, *, var: str = "acc"):
     **warning** (no single unit mistake explains it: a scale error, a gravity-compensated
     signal, free fall). Medians beyond 50 g are left to :func:`check_raw_counts`.
 
+    The m/s²-looks-like-g error needs gravity to be there: when the sampling rate is
+    known and the acceleration averaged over 1 s keeps less than half of its median
+    magnitude (a gravity-free "linear acceleration" signal, whose median in m/s² can be
+    about 1), the finding is only a warning.
+
     Returns
     -------
     Finding or None
     """
     name = _name(acc, var)
-    v, u, _, _, _ = _read(acc, name, units=units)
+    v, u, _, fs, _ = _read(acc, name, units=units)
     rows = _finite_rows(v)
     if not rows.size:
         return None
@@ -557,6 +609,22 @@ def check_acc_units(acc, units: str | None = None, *, var: str = "acc"):
     if lo <= g <= hi or g > ACC_COUNTS_G:
         return None
     other = "m/s^2" if u == "g" else "g"
+    gravity_free = False
+    if other == "g" and fs is not None and rows.shape[0] > 2 * fs:
+        w = max(1, int(round(fs)))
+        c = np.cumsum(np.vstack([np.zeros((1, 3)), rows]), axis=0)
+        mean_1s = np.linalg.norm((c[w:] - c[:-w]) / w, axis=1)
+        gravity_free = float(np.median(mean_1s)) < 0.5 * med
+    if gravity_free and lo <= med * _units.conversion_factor(other, "g") <= hi:
+        return Finding(
+            name,
+            "acc_units",
+            "warning",
+            f"{name}: median magnitude {med:.3g} {_u(u)} is far from gravity's 9.81 and "
+            "its 1-s average is small: a gravity-free (linear acceleration) signal, or g "
+            "labelled m/s²; tilt needs the gravity-including accelerometer",
+            med,
+        )
     if lo <= med * _units.conversion_factor(other, "g") <= hi:
         return Finding(
             name,
@@ -576,27 +644,76 @@ def check_acc_units(acc, units: str | None = None, *, var: str = "acc"):
     )
 
 
-def _tilt_span(acc: np.ndarray, fs: float) -> float | None:
-    """A lower bound (rad) of how far the gravity direction seen by the accelerometer
-    turns: the angle between two of its directions, smoothed over 0.5 s and taken on
-    samples whose magnitude is within 10 % of the median (gravity-dominated)."""
-    a = _finite_rows(acc)
-    w = max(1, int(round(0.5 * fs)))
-    if a.shape[0] < 2 * w:
-        return None
+def _smoothed_directions(
+    acc: np.ndarray, w: int, tol: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """Unit directions of the acceleration averaged over ``w`` samples (centred), and
+    whether each is gravity-dominated (its magnitude within ``tol`` of the median)."""
+    a = np.where(np.isfinite(acc), acc, 0.0)
     c = np.cumsum(np.vstack([np.zeros((1, 3)), a]), axis=0)
-    sm = (c[w:] - c[:-w]) / w
+    n = a.shape[0]
+    lo = np.clip(np.arange(n) - w // 2, 0, n)
+    hi = np.clip(lo + w, 0, n)
+    sm = (c[hi] - c[lo]) / np.maximum(hi - lo, 1)[:, None]
     norm = np.linalg.norm(sm, axis=1)
-    med = float(np.median(norm))
-    if not med > 0:
-        return None
-    keep = np.abs(norm / med - 1.0) < 0.1
-    if keep.sum() < 2:
-        return None
-    d = sm[keep] / norm[keep, None]
-    i = int(np.argmin(d @ d[0]))
-    j = int(np.argmin(d @ d[i]))
-    return float(np.arccos(np.clip(d[i] @ d[j], -1.0, 1.0)))
+    med = float(np.median(norm)) if n else 0.0
+    ok = np.isfinite(acc).all(axis=1) & (norm > 0)
+    if med > 0:
+        ok &= np.abs(norm / med - 1.0) < tol
+    d = sm / np.where(norm > 0, norm, 1.0)[:, None]
+    return d, ok
+
+
+#: Window (s) over which the gyroscope's rotation is compared with the accelerometer's
+#: tilt, the smallest tilt (degrees) that counts as turning, and the share of turning
+#: windows that must contradict the label before it is refused (below: a warning).
+GYR_WINDOW_S: float = 1.0
+GYR_MIN_TILT_DEG: float = 20.0
+GYR_DECISIVE_SHARE: float = 0.6
+
+
+def _rotation_bound(
+    gyr_rad_s: np.ndarray, acc: np.ndarray, fs: float
+) -> tuple[int, int, float]:
+    """Windows in which the accelerometer turns by more than ``GYR_MIN_TILT_DEG``, and
+    how many of them the gyroscope cannot explain (it integrates to less than a fifth
+    of that tilt), and the median |cosine| between the axis the accelerometer turns
+    about and the gyroscope's (perpendicular to gravity) in those windows: the |median
+    signed cosine|. The angle between two gravity directions is at most the rotation
+    integrated between them, so a correctly labelled gyroscope explains every window,
+    whatever its bias or noise."""
+    n = gyr_rad_s.shape[0]
+    w = max(1, int(round(0.25 * fs)))  # direction smoothing (vibration, noise)
+    step = max(1, int(round(GYR_WINDOW_S * fs)))
+    if n < step + 2 * w:
+        return 0, 0, float("nan")
+    d, ok = _smoothed_directions(acc, w, 0.05)
+    speed = np.linalg.norm(np.where(np.isfinite(gyr_rad_s), gyr_rad_s, 0.0), axis=1)
+    integral = np.concatenate([[0.0], np.cumsum(speed) / fs])
+    i0 = np.arange(w, n - step - w, step)
+    i1 = i0 + step
+    good = ok[i0] & ok[i1]
+    tilt = np.arccos(np.clip(np.sum(d[i0] * d[i1], axis=1), -1.0, 1.0))
+    # the smoothed directions see half a smoothing window beyond each end
+    turned = (
+        integral[np.minimum(i1 + w // 2 + 1, n)] - integral[np.maximum(i0 - w // 2, 0)]
+    )
+    turning = good & (tilt > np.radians(GYR_MIN_TILT_DEG))
+    unexplained = turning & (turned < tilt / 5.0)
+    # does the gyroscope turn about the axis the accelerometer turns about? (its
+    # direction does not depend on the unit label; noise and bias point anywhere)
+    gsum = np.vstack([np.zeros((1, 3)), np.cumsum(np.nan_to_num(gyr_rad_s), axis=0)])
+    rot = gsum[i1] - gsum[i0]
+    axis_acc = np.cross(d[i0], d[i1])
+    mean_g = d[i0] + d[i1]
+    mean_g /= np.maximum(np.linalg.norm(mean_g, axis=1, keepdims=True), 1e-12)
+    rot_perp = rot - np.sum(rot * mean_g, axis=1, keepdims=True) * mean_g
+    denom = np.linalg.norm(axis_acc, axis=1) * np.linalg.norm(rot_perp, axis=1)
+    # signed: for a right-handed frame d0 × d1 = −θ ω̂⊥, so the cosine is near −1 in
+    # every window (near +1 for a left-handed one); noise gives cosines of either sign
+    cos = np.sum(axis_acc * rot_perp, axis=1) / np.maximum(denom, 1e-300)
+    agree = abs(float(np.median(cos[unexplained]))) if unexplained.any() else 0.0
+    return int(turning.sum()), int(unexplained.sum()), agree
 
 
 def check_gyr_units(
@@ -612,11 +729,14 @@ def check_gyr_units(
     * Labelled rad/s: a 99th percentile of ``|gyr|`` above 40 rad/s (2300 °/s, beyond the
       full scale of most MEMS gyroscopes) looks like °/s: a **warning**; above 100 rad/s
       (5700 °/s, beyond any MEMS gyroscope) it cannot be rad/s: an **error**.
-    * Labelled °/s: decided only when the accelerometer shows the sensor turning. The
-      angle between two gravity directions is at most the rotation integrated between
-      them, ``∫|ω| dt``; if the gyroscope, read in °/s, integrates to less than a fifth of
-      a tilt of more than 45°, its values are rad/s (or it does not work): an **error**.
-      (Gyroscope bias and noise only add to the integral, so they cannot cause it.)
+    * Labelled °/s: decided from the accelerometer, window by window. Over
+      ``GYR_WINDOW_S`` = 1 s, the angle between two gravity directions is at most the
+      rotation integrated between them, ``∫|ω| dt``; a gyroscope that, read in °/s,
+      integrates to less than a fifth of the tilt in most (``GYR_DECISIVE_SHARE``) of at
+      least three windows that turn by more than 20° is in rad/s (or does not work): an
+      **error**. Fewer such windows (linear acceleration can turn the accelerometer
+      without rotation) are a **warning**. Bias and noise only add to the integral, so
+      they cannot cause either; a still or barely turning recording is not judged.
 
     Parameters
     ----------
@@ -666,24 +786,77 @@ def check_gyr_units(
     a = np.asarray(acc, dtype=float)
     if a.shape != v.shape or v.shape[1] != 3:
         return None
+    rad = v * _units.conversion_factor(u, "rad/s")
+    # over the whole recording: the gyroscope must explain the largest tilt (decisive:
+    # no linear acceleration holds the accelerometer 45° off for half a second)
     ok = np.isfinite(v).all(axis=1)
-    if ok.mean() < 0.99:
+    if ok.mean() >= 0.99:
+        tilt = _tilt_span(a, f)
+        turned_all = float(np.linalg.norm(rad[ok], axis=1).sum() / f)
+        if tilt is not None and tilt >= np.radians(45.0) and turned_all < tilt / 5.0:
+            return Finding(
+                name,
+                "gyr_units",
+                "error",
+                f"{name} is labelled °/s but integrates to {np.degrees(turned_all):.3g}° "
+                f"of rotation while the accelerometer tilts by {np.degrees(tilt):.0f}°: "
+                "looks like rad/s (set units='rad/s'), or the gyroscope is not working",
+                np.degrees(turned_all),
+            )
+    turning, unexplained, agree = _rotation_bound(rad, a, f)
+    if turning < 3 or unexplained == 0:
         return None
-    tilt = _tilt_span(a, f)
-    if tilt is None or tilt < np.radians(45.0):
+    share = unexplained / turning
+    # decisive: most turning windows unexplained, and the gyroscope does turn about
+    # the accelerometer's axis (it measures the rotation, too small by a unit factor)
+    decisive = share >= GYR_DECISIVE_SHARE and agree >= 0.8
+    if not decisive and share < 0.2:
         return None
-    turned = float(norm.sum() / f * _units.conversion_factor(u, "rad/s"))
-    if turned >= tilt / 5.0:
-        return None
+    what = (
+        f"in {unexplained} of {turning} one-second windows where the accelerometer "
+        f"tilts by more than {GYR_MIN_TILT_DEG:g}°, {name} (read as °/s) integrates to "
+        "less than a fifth of that tilt"
+    )
+    if decisive:
+        return Finding(
+            name,
+            "gyr_units",
+            "error",
+            f"{name} is labelled °/s but {what}, about the same axis: looks like rad/s "
+            "(set units='rad/s')",
+            share,
+        )
     return Finding(
         name,
         "gyr_units",
-        "error",
-        f"{name} is labelled °/s but integrates to {np.degrees(turned):.3g}° of "
-        f"rotation while the accelerometer tilts by {np.degrees(tilt):.0f}°: looks like "
-        "rad/s (set units='rad/s'), or the gyroscope is not working",
-        np.degrees(turned),
+        "warning",
+        f"{what}: if {name} is really °/s, the accelerometer also sees linear "
+        "acceleration; if not, it may be rad/s",
+        share,
     )
+
+
+def _tilt_span(acc: np.ndarray, fs: float) -> float | None:
+    """A lower bound (rad) of how far the gravity direction seen by the accelerometer
+    turns: the angle between two of its directions, smoothed over 0.5 s and taken on
+    samples whose magnitude is within 10 % of the median (gravity-dominated)."""
+    a = _finite_rows(acc)
+    w = max(1, int(round(0.5 * fs)))
+    if a.shape[0] < 2 * w:
+        return None
+    c = np.cumsum(np.vstack([np.zeros((1, 3)), a]), axis=0)
+    sm = (c[w:] - c[:-w]) / w
+    norm = np.linalg.norm(sm, axis=1)
+    med = float(np.median(norm))
+    if not med > 0:
+        return None
+    keep = np.abs(norm / med - 1.0) < 0.1
+    if keep.sum() < 2:
+        return None
+    d = sm[keep] / norm[keep, None]
+    i = int(np.argmin(d @ d[0]))
+    j = int(np.argmin(d @ d[i]))
+    return float(np.arccos(np.clip(d[i] @ d[j], -1.0, 1.0)))
 
 
 def check_temperature(temp, units: str | None = None, *, var: str = "temp"):
@@ -791,9 +964,9 @@ def _stacklevel() -> int:
 def emit(findings: Sequence[Finding]) -> None:
     """Raise :class:`RecordingError` with every error's message (joined by ``"; "``),
     else warn each warning as a :class:`QualityWarning`."""
-    errors = [f.message for f in findings if f.is_error]
+    errors = [f for f in findings if f.is_error]
     if errors:
-        raise RecordingError("; ".join(errors))
+        raise UnitCheckError(errors)
     level = _stacklevel()
     for f in findings:
         warnings.warn(f.message, QualityWarning, stacklevel=level)

@@ -25,15 +25,18 @@ samples (:mod:`tiltlab.quality`): hard problems raise, soft ones warn
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+import warnings
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 import numpy as np
 import xarray as xr
 
+from . import axes as _axes
 from . import quality as _quality
 from . import units as _units
 from ._validate import RecordingError
+from .quality import UnitCheckError
 from ._validate import check_fs as _check_fs
 from ._validate import finite as _finite
 from ._validate import nonnegative as _nonnegative
@@ -43,6 +46,7 @@ __all__ = [
     "AXES",
     "QUAT",
     "RecordingError",
+    "UnitCheckError",
     "make_recording",
     "validate",
     "to_units",
@@ -64,35 +68,47 @@ _PROVENANCE = ("source", "sensor", "subject", "session")
 
 def make_recording(
     acc,
-    gyr,
-    fs: float,
+    gyr=None,
+    fs: float | None = None,
     *,
-    acc_units: str = "g",
-    gyr_units: str = "deg/s",
+    acc_units: str | None = None,
+    gyr_units: str | None = None,
     mag=None,
-    mag_units: str = "uT",
+    mag_units: str | None = None,
     acc_range=None,
     gyr_range=None,
     mag_range=None,
     temp=None,
-    temp_units: str = "degC",
+    temp_units: str | None = None,
     q_ref=None,
     time=None,
     t0: float = 0.0,
     frame: str = "sensor",
+    axes=None,
+    preset: str | None = None,
+    axis_labels: Sequence[str] | None = None,
     extra: Mapping[str, Any] | None = None,
     attrs: Mapping[str, Any] | None = None,
     validate_result: bool = True,
+    check_units: bool = True,
     **validate_kwargs,
 ) -> xr.Dataset:
     """Build a validated Recording from arrays.
 
     Parameters
     ----------
-    acc, gyr : array_like, shape (N, 3)
-        Accelerometer and gyroscope samples in ``acc_units`` / ``gyr_units``.
+    acc : array_like or xarray.DataArray, shape (N, 3)
+        Accelerometer samples (specific force) in ``acc_units``.
+    gyr : array_like or xarray.DataArray, shape (N, 3), optional
+        Gyroscope samples in ``gyr_units``. Optional: most bio-logging tags have none,
+        and a Recording without ``gyr`` is valid (methods that need it refuse by name).
     fs : float
         Sampling rate in Hz. Mandatory: tiltlab never assumes a default.
+    acc_units, gyr_units, mag_units, temp_units : str
+        Units of each variable given (``"g"``, ``"m/s^2"``, ``"deg/s"``, ``"rad/s"``,
+        ``"uT"``, ``"degC"`` …). Required for a plain array; a labelled DataArray's
+        ``units`` attribute is used when the argument is omitted. tiltlab never assumes a
+        unit.
     mag : array_like, shape (N, 3), optional
         Magnetometer samples in ``mag_units``.
     acc_range, gyr_range, mag_range : float or (float, float), optional
@@ -107,6 +123,16 @@ def make_recording(
         Sample times in seconds; default ``t0 + arange(N) / fs``.
     frame : str
         Frame in which the vectors are expressed (default ``"sensor"``).
+    axes : sequence of str or mapping, optional
+        How the device's axes map into the sensor frame, e.g. ``["x", "-y", "z"]``, or
+        per variable ``{"acc": [...], "gyr": [...]}`` (:func:`tiltlab.axes.remap`).
+    preset : str, optional
+        A named device convention (:data:`tiltlab.axes.PRESETS`: ``"android"``,
+        ``"ios"``, ``"tagtools"``, ``"animal"`` …) giving the axes, signs and axis labels.
+        A left-handed device frame is refused unless ``axes`` makes it right-handed.
+    axis_labels : sequence of 3 str, optional
+        What the sensor axes point to (e.g. ``["forward", "left", "up"]``), stored in
+        ``attrs['axis_labels']`` and used by the figure recipes.
     extra : mapping, optional
         Additional per-sample variables, ``name -> array`` (first dim = time) or
         ``name -> (dims, array, attrs)``. Copied: the Recording never shares memory with
@@ -115,6 +141,12 @@ def make_recording(
         Dataset attributes (provenance: ``source``, ``sensor``, ``subject``, ``session`` …).
     validate_result : bool
         Run :func:`validate` on the result (default True).
+    check_units : bool
+        Check the values against their unit labels (:func:`validate`). Decisive
+        contradictions raise :class:`UnitCheckError` naming every variable at once;
+        ambiguous ones warn and are kept in ``attrs['quality_warnings']``. ``False``
+        accepts the labels as they are (the one switch, honoured by every reader and
+        command).
     **validate_kwargs
         Passed to :func:`validate`.
 
@@ -122,6 +154,15 @@ def make_recording(
     -------
     xarray.Dataset
         The Recording.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from tiltlab import schema
+    >>> acc = np.tile([0.0, 0.0, 1.0], (200, 1))
+    >>> rec = schema.make_recording(acc, fs=50.0, acc_units="g")  # no gyroscope
+    >>> sorted(rec.data_vars), rec.attrs["fs"]
+    (['acc'], 50.0)
     """
     if fs is None:
         raise RecordingError(
@@ -131,22 +172,43 @@ def make_recording(
         fs = _check_fs(fs)
     except ValueError as err:
         raise RecordingError(str(err)) from None
-    acc = np.asarray(acc, dtype=float)
-    gyr = np.asarray(gyr, dtype=float)
+    acc_units = _given_units(acc, acc_units, "acc")
+    acc = _as_array(acc, "acc")
     if acc.ndim != 2 or acc.shape[1] != 3:
         raise RecordingError(f"acc must have shape (N, 3), got {acc.shape}")
-    if gyr.ndim != 2 or gyr.shape[1] != 3:
-        raise RecordingError(f"gyr must have shape (N, 3), got {gyr.shape}")
-    if acc.shape[0] != gyr.shape[0]:
-        raise RecordingError(
-            f"acc and gyr lengths differ: {acc.shape[0]} vs {gyr.shape[0]} samples"
-        )
     n = acc.shape[0]
+    if gyr is not None:
+        gyr_units = _given_units(gyr, gyr_units, "gyr")
+        gyr = _as_array(gyr, "gyr")
+        if gyr.ndim != 2 or gyr.shape[1] != 3:
+            raise RecordingError(f"gyr must have shape (N, 3), got {gyr.shape}")
+        if gyr.shape[0] != n:
+            raise RecordingError(
+                f"acc and gyr lengths differ: {n} vs {gyr.shape[0]} samples"
+            )
+    if mag is not None:
+        mag_units = _given_units(mag, mag_units, "mag")
+        mag = _as_array(mag, "mag")
+    if temp is not None:
+        temp_units = _given_units(temp, temp_units, "temp")
+        temp = _as_array(temp, "temp")
     if time is None:
         time = t0 + np.arange(n) / fs
     time = np.array(time, dtype=float)  # a copy: never alias the caller's array
     if time.shape != (n,):
         raise RecordingError(f"time must have shape ({n},), got {time.shape}")
+    frame_attrs: dict[str, Any] = {}
+    if axes is not None or preset is not None:
+        vectors = {
+            k: v for k, v in (("acc", acc), ("gyr", gyr), ("mag", mag)) if v is not None
+        }
+        try:
+            vectors, frame_attrs = _axes.remap(vectors, axes, preset=preset)
+        except ValueError as err:
+            raise RecordingError(str(err)) from None
+        acc, gyr, mag = vectors["acc"], vectors.get("gyr"), vectors.get("mag")
+    if axis_labels is not None:
+        frame_attrs["axis_labels"] = _axes.check_labels(axis_labels)
 
     data_vars: dict[str, Any] = {
         "acc": (
@@ -157,25 +219,26 @@ def make_recording(
                 "long_name": "acceleration (specific force)",
             },
         ),
-        "gyr": (
+    }
+    if gyr is not None:
+        data_vars["gyr"] = (
             ("time", "axis"),
             gyr.copy(),
             {
                 "units": _units.normalise_unit(gyr_units),
                 "long_name": "angular velocity",
             },
-        ),
-    }
+        )
     if mag is not None:
         data_vars["mag"] = (
             ("time", "axis"),
-            np.array(mag, dtype=float),
+            mag,
             {"units": _units.normalise_unit(mag_units), "long_name": "magnetic field"},
         )
     if temp is not None:
         data_vars["temp"] = (
             ("time",),
-            np.array(temp, dtype=float),
+            temp,
             {
                 "units": _units.normalise_unit(temp_units),
                 "long_name": "sensor temperature",
@@ -227,11 +290,59 @@ def make_recording(
             "axis": list(AXES),
             **({"quat": list(QUAT)} if q_ref is not None else {}),
         },
-        attrs={"fs": fs, "frame": frame, **dict(attrs or {})},
+        attrs={"fs": fs, "frame": frame, **frame_attrs, **dict(attrs or {})},
     )
     if validate_result:
-        validate(ds, **validate_kwargs)
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            validate(ds, check_units=check_units, **validate_kwargs)
+        doubts = [
+            str(w.message)
+            for w in caught
+            if issubclass(w.category, _quality.QualityWarning)
+        ]
+        if doubts:  # ambiguous evidence: kept with the data, and told
+            ds.attrs["quality_warnings"] = [
+                *list(ds.attrs.get("quality_warnings", [])),
+                *doubts,
+            ]
+        for w in caught:
+            warnings.warn_explicit(
+                w.message, w.category, w.filename, w.lineno, source=w.source
+            )
     return ds
+
+
+def _given_units(x, units: str | None, name: str) -> str:
+    """The unit of a variable: the argument, else a labelled DataArray's ``units``
+    attribute (which the argument must not contradict); never a default."""
+    label = x.attrs.get("units") if isinstance(x, xr.DataArray) else None
+    if units is None:
+        if label is None:
+            raise RecordingError(
+                f"{name}_units is required for a plain array: tiltlab never assumes a "
+                f"unit (e.g. {name}_units={_EXAMPLE_UNITS[name]!r})"
+            )
+        units = label
+    try:
+        canon = _units.normalise_unit(units)
+    except _units.UnitsError as exc:
+        raise RecordingError(f"{name}_units: {exc}") from None
+    if label is not None and _units.normalise_unit(label) != canon:
+        raise RecordingError(
+            f"{name}_units={units!r} contradicts the DataArray's units {label!r}"
+        )
+    return canon
+
+
+def _as_array(x, name: str) -> np.ndarray:
+    try:
+        return np.array(x, dtype=float)  # a copy: never alias the caller's array
+    except (TypeError, ValueError) as exc:
+        raise RecordingError(f"{name} must be numeric: {exc}") from None
+
+
+_EXAMPLE_UNITS = {"acc": "g", "gyr": "deg/s", "mag": "uT", "temp": "degC"}
 
 
 def _check_vector_var(ds: xr.Dataset, name: str, allow_nan: bool) -> None:
@@ -302,10 +413,13 @@ def validate(
         Tolerance on ``| ‖q‖ − 1 |`` for ``q_ref``.
     check_units : bool
         Run the plausibility checks of the values against their units
-        (:func:`tiltlab.quality.plausibility`: accelerometer magnitude, raw ADC counts,
-        gyroscope magnitude, temperature) and the gyroscope unit check
-        (:func:`tiltlab.units.check_gyro_units`). Their hard findings (e.g. ``acc``
-        labelled g with a median magnitude of 9.8) raise, the soft ones warn.
+        (:func:`tiltlab.quality.plausibility`: raw ADC counts, accelerometer magnitude,
+        gyroscope rate against the accelerometer's tilt, temperature). Decisive findings
+        (e.g. ``acc`` labelled g with a median magnitude of 9.8) raise one
+        :class:`UnitCheckError` listing every variable; ambiguous ones warn. ``False``
+        accepts the labels as they are: the one switch, honoured by every reader, the
+        mapping file (``"check_units": false``), the command line (``--no-check-units``)
+        and a cohort manifest's ``reader_options``.
     check_saturation : bool
         Warn (:class:`tiltlab.quality.QualityWarning`) about clipped samples of ``acc``,
         ``gyr`` and ``mag``, with the fraction clipped per variable
@@ -319,7 +433,10 @@ def validate(
     Raises
     ------
     RecordingError
-        With a message naming the first problem found (all hard plausibility problems).
+        With a message naming the first contract problem found.
+    UnitCheckError
+        (a RecordingError) When values decisively contradict their unit labels; the
+        message names every such variable, the likely unit and the switch.
 
     Warns
     -----
@@ -347,16 +464,20 @@ def validate(
         raise RecordingError(f"attribute 'fs' must be positive and finite, got {fs!r}")
     if "frame" not in ds.attrs:
         raise RecordingError("attribute 'frame' is missing (normally 'sensor')")
-    for v in ("acc", "gyr"):
-        if v not in ds:
-            raise RecordingError(f"variable {v!r} is missing")
+    if "acc" not in ds:
+        raise RecordingError(
+            "variable 'acc' is missing (a Recording needs at least an accelerometer)"
+        )
     if "time" not in ds.coords:
         raise RecordingError("coordinate 'time' is missing")
     if "axis" not in ds.coords or tuple(str(a) for a in ds["axis"].values) != AXES:
         raise RecordingError(f"coordinate 'axis' must be {AXES}")
-    n_acc, n_gyr = ds["acc"].sizes.get("time"), ds["gyr"].sizes.get("time")
-    if n_acc != n_gyr:
-        raise RecordingError(f"acc and gyr lengths differ: {n_acc} vs {n_gyr} samples")
+    if "gyr" in ds:
+        n_acc, n_gyr = ds["acc"].sizes.get("time"), ds["gyr"].sizes.get("time")
+        if n_acc != n_gyr:
+            raise RecordingError(
+                f"acc and gyr lengths differ: {n_acc} vs {n_gyr} samples"
+            )
 
     t = np.asarray(ds["time"].values, dtype=float)
     if t.ndim != 1:
@@ -421,23 +542,9 @@ def validate(
             )
 
     findings = _quality.plausibility(ds) if check_units else []
-    if any(f.is_error for f in findings):
-        try:
-            _quality.emit(findings)
-        except RecordingError as exc:
-            raise RecordingError(
-                f"{exc} (validate(..., check_units=False) skips this check)"
-            ) from None
-    if check_units:
-        acc = np.asarray(ds["acc"].values, dtype=float)
-        gyr = np.asarray(ds["gyr"].values, dtype=float)
-        if allow_nan:
-            keep = np.isfinite(acc).all(axis=1) & np.isfinite(gyr).all(axis=1)
-            acc, gyr = acc[keep], gyr[keep]
-        try:
-            _units.check_gyro_units(gyr, ds["gyr"].attrs["units"], acc, fs)
-        except _units.UnitsError as exc:
-            raise RecordingError(str(exc)) from None
+    errors = [f for f in findings if f.is_error]
+    if errors:
+        raise UnitCheckError(errors)
     if check_saturation:
         findings += _quality.check_saturation(ds)
     _quality.emit(findings)

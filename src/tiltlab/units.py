@@ -23,8 +23,6 @@ __all__ = [
     "convert",
     "acc_to_g",
     "gyr_to_rad_s",
-    "check_gyro_units",
-    "check_fs",
 ]
 
 #: Standard gravity (m/s²), the conversion factor between g and m/s² (CGPM 1901).
@@ -148,83 +146,3 @@ def acc_to_g(values, units: str) -> np.ndarray:
 def gyr_to_rad_s(values, units: str) -> np.ndarray:
     """Angular velocity in rad/s from ``units`` ('deg/s' or 'rad/s')."""
     return convert(values, units, "rad/s")
-
-
-def check_gyro_units(
-    gyr,
-    gyr_units: str,
-    acc,
-    fs: float,
-    *,
-    min_tilt_rate: float = 0.5,
-    raise_error: bool = True,
-) -> float | None:
-    """Check that the gyroscope's stated unit is consistent with the accelerometer.
-
-    When the sensor turns, the direction of the (low-passed) acceleration turns too, and
-    its angular rate is a lower bound of the true angular speed: the component of
-    ``ω`` perpendicular to gravity. We estimate that tilt rate from the accelerometer
-    on the samples where it exceeds ``min_tilt_rate`` (rad/s) and compare it with the
-    gyroscope norm converted with the *stated* unit. A correct unit gives a median ratio
-    of order one (≥ ~0.5); a gyroscope in rad/s labelled °/s gives ~1/57, one in °/s
-    labelled rad/s gives ~57.
-
-    Parameters
-    ----------
-    gyr : array_like, shape (N, 3)
-        Angular velocity in ``gyr_units``.
-    gyr_units : str
-        Stated unit ('deg/s' or 'rad/s').
-    acc : array_like, shape (N, 3)
-        Acceleration in any unit (only its direction is used).
-    fs : float
-        Sampling rate (Hz).
-    min_tilt_rate : float
-        Tilt rates (rad/s) below this are too small to judge and ignored.
-    raise_error : bool
-        Raise :class:`UnitsError` on an implausible ratio (default), else return it.
-
-    Returns
-    -------
-    float or None
-        Median ratio ‖ω‖ / tilt rate, or None when the recording has too little rotation
-        to decide (e.g. a static recording).
-    """
-    gyr = np.asarray(gyr, dtype=float)
-    acc = np.asarray(acc, dtype=float)
-    fs = check_fs(fs)
-    # too short to judge, also when the ~50 ms smoothing window spans the recording
-    if gyr.shape[0] < 10 or 0.05 * fs >= gyr.shape[0] / 2:
-        return None
-    # smooth the acceleration direction over ~50 ms to suppress noise and vibration
-    w = max(1, int(round(0.05 * fs)))
-    kernel = np.ones(w) / w
-    a = np.column_stack([np.convolve(acc[:, k], kernel, mode="same") for k in range(3)])
-    n = np.linalg.norm(a, axis=1, keepdims=True)
-    ok = n[:, 0] > 0
-    u = np.where(ok[:, None], a / np.where(n > 0, n, 1.0), np.nan)
-    step = max(1, w)
-    cosang = np.clip(np.sum(u[step:] * u[:-step], axis=1), -1.0, 1.0)
-    tilt_rate = np.arccos(cosang) * fs / step
-    omega = np.linalg.norm(gyr, axis=1) * conversion_factor(gyr_units, "rad/s")
-    omega_mid = 0.5 * (omega[step:] + omega[:-step])
-    sel = np.isfinite(tilt_rate) & (tilt_rate > min_tilt_rate)
-    if sel.sum() < max(20, int(0.2 * fs)):
-        return None
-    ratio = float(np.median(omega_mid[sel] / tilt_rate[sel]))
-    if raise_error and not (0.2 < ratio < 20.0):
-        hint = (
-            "values look like rad/s labelled deg/s"
-            if ratio <= 0.2
-            else "values look like deg/s labelled rad/s"
-        )
-        raise UnitsError(
-            f"gyroscope units {gyr_units!r} are implausible: the gyroscope norm is {ratio:.3g}× the "
-            f"rotation rate of the acceleration direction (expected ≥ ~0.5 and ≲ a few); {hint}. "
-            "Fix the 'units' attribute, or pass check_units=False to validate()."
-        )
-    return ratio
-
-
-# one implementation, in the validation module (imported last: it imports this module)
-from ._validate import check_fs  # noqa: E402

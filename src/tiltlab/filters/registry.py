@@ -11,7 +11,14 @@ signature with :mod:`inspect`, so that a default value is written in exactly one
 * ``supports_mag`` — the function has a ``mag`` argument (9D possible), unless the
   entry is marked ``six_d`` (an adapter that keeps ``mag=None`` only for the uniform
   signature: RIANN);
-* ``uses_gyr`` — the function has a ``gyr`` argument (``lowpass`` has not).
+* ``uses_gyr`` — the function has a ``gyr`` argument (``lowpass`` and ``davenport``
+  have not);
+* ``needs`` — the Recording variables the method cannot run without: ``acc`` always,
+  ``gyr`` when ``uses_gyr``, ``mag`` for an entry marked ``requires_mag``
+  (``davenport``). :func:`methods` selects by them (``methods(needs="acc")``: the
+  methods that run on an accelerometer alone, as on most bio-logging tags), and
+  :func:`tiltlab.filters.estimate` refuses a method whose variable is missing, naming
+  the methods that would run.
 
 Adapters to the ``vqf`` package also accept that package's own parameters
 (``extra_params``).
@@ -34,15 +41,21 @@ from .madgwick import madgwick
 from .mahony import mahony
 from .rts import rts_smoother
 from .smoothers import smoother
+from .vectors import davenport, magnetic_dip
 
 __all__ = [
     "Method",
     "METHODS",
     "PARAMETER_UNITS",
+    "SENSORS",
     "methods",
     "get_method",
     "defaults",
+    "missing_sensor_message",
 ]
+
+#: the sensor variables a method can need, in the order they are listed
+SENSORS = ("acc", "gyr", "mag")
 
 #: units of the tunable parameters, as the filters' docstrings state them ("1": unitless);
 #: figure recipes label parameter axes with them
@@ -58,6 +71,7 @@ PARAMETER_UNITS: Mapping[str, str] = MappingProxyType(
         "tau_acc_s": "s",
         "gyr_noise": "rad/√s",
         "acc_noise": "m/s/√s",
+        "dip": "rad",
     }
 )
 
@@ -92,6 +106,9 @@ class Method:
         The method is 6D only although its function has a ``mag`` argument (kept, as
         ``mag=None``, for the adapters' uniform signature): ``supports_mag`` is False,
         so ``use_mag=True`` is refused before any data are read.
+    requires_mag : bool
+        The method cannot run without a magnetometer (a vector-observation method):
+        :func:`~tiltlab.filters.estimate` then reads ``mag`` whatever ``use_mag``.
     """
 
     name: str
@@ -100,6 +117,7 @@ class Method:
     description: str
     extra_params: Callable[[], Collection[str]] | None = None
     six_d: bool = False
+    requires_mag: bool = False
 
     def _signature(self) -> Mapping[str, inspect.Parameter]:
         return inspect.signature(self.function).parameters
@@ -135,6 +153,16 @@ class Method:
         """Whether the method uses the gyroscope."""
         return "gyr" in self._signature()
 
+    @property
+    def needs(self) -> tuple[str, ...]:
+        """The Recording variables the method cannot run without (``acc`` always,
+        ``gyr`` when it integrates the gyroscope, ``mag`` when it requires one)."""
+        return (
+            ("acc",)
+            + (("gyr",) if self.uses_gyr else ())
+            + (("mag",) if self.requires_mag else ())
+        )
+
     def resolve(self, params: Mapping[str, Any]) -> dict[str, Any]:
         """``defaults`` updated with ``params``; an unknown name is a ValueError."""
         known = set(self.defaults) | set(self.options)
@@ -160,12 +188,86 @@ class Method:
                 f"method {self.name!r} does not use a magnetometer; "
                 "use_mag=True is not supported"
             )
+        if mag is None and self.requires_mag:
+            raise ValueError(missing_sensor_message(self, "mag"))
         kw = dict(params)
         if mag is not None:
             kw["mag"] = mag
         if self.uses_gyr:
+            if gyr is None:
+                raise ValueError(missing_sensor_message(self, "gyr"))
             return self.function(acc, gyr, fs, **kw)
         return self.function(acc, fs, **kw)
+
+
+def vector_observation(
+    acc, fs: float, *, mag, dip: float | None = None, cutoff_hz: float | None = None
+):
+    r"""Orientation from the accelerometer and magnetometer alone, sample by sample
+    (Davenport's q-method, :func:`tiltlab.filters.davenport`); no gyroscope.
+
+    The gravity-up observation is the specific force and the north observation the
+    magnetic field; :math:`q_k` maximises Wahba's gain
+    :math:`\sum_i a_i\, b_{i,k}^\top A(q_k)\, r_i` for the two of them (Davenport 1968;
+    Markley & Crassidis 2014, §5.5). With ``cutoff_hz`` both series are first low-passed
+    (zero phase, :func:`tiltlab.dsp.lowpass`), so that the body's own accelerations
+    average out as in the ``lowpass`` method; without it every sample is used raw.
+
+    Parameters
+    ----------
+    acc : array_like, shape (N, 3)
+        Specific force (any unit; only its direction is used).
+    fs : float
+        Sampling rate (Hz), mandatory.
+    mag : array_like, shape (N, 3)
+        Magnetic field (any unit; only its direction is used). Required.
+    dip : float, optional
+        Magnetic dip (rad, positive downwards); default: measured from the recording,
+        the mean of :func:`tiltlab.filters.magnetic_dip` over its samples.
+    cutoff_hz : float, optional
+        Low-pass cut-off (Hz, ``0 < cutoff_hz < fs/2``) applied to ``acc`` and ``mag``
+        before the q-method; ``None`` (default): raw samples.
+
+    Returns
+    -------
+    numpy.ndarray, shape (N, 4)
+        Unit quaternions sensor → world (ENU: x east, y magnetic north, z up).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> acc = np.tile([0.0, 0.0, 9.81], (50, 1))
+    >>> mag = np.tile([0.0, 20.0, -40.0], (50, 1))
+    >>> q = vector_observation(acc, 50.0, mag=mag)
+    >>> np.allclose(q, [1.0, 0.0, 0.0, 0.0])
+    True
+
+    References
+    ----------
+    .. [1] P. B. Davenport, "A vector approach to the algebra of rotations with
+       applications", NASA TN D-4696, 1968.
+    .. [2] F. L. Markley and J. L. Crassidis, *Fundamentals of Spacecraft Attitude
+       Determination and Control*, Springer, 2014, §5.5.
+       doi:10.1007/978-1-4939-0802-8
+    """
+    from .. import _validate as _v
+    from .. import dsp
+
+    fs = _v.check_fs(fs)
+    a = _v.vectors(acc, "acc", width=3, ndim=2)
+    m = _v.vectors(mag, "mag", width=3, ndim=2)
+    if a.shape != m.shape:
+        raise ValueError(
+            f"acc and mag must have the same number of samples, got {a.shape[0]} and "
+            f"{m.shape[0]}"
+        )
+    if cutoff_hz is not None:
+        a = dsp.lowpass(a, fs, cutoff_hz, name="acc")
+        m = dsp.lowpass(m, fs, cutoff_hz, name="mag")
+    if a.shape[0] == 0:
+        return np.zeros((0, 4))
+    d = magnetic_dip(a, m) if dip is None else _v.finite(dip, "dip")
+    return davenport(a, m, dip=d)
 
 
 def _registry(*entries: Method) -> Mapping[str, Method]:
@@ -182,6 +284,14 @@ METHODS: Mapping[str, Method] = _registry(
         lowpass_tilt,
         "offline",
         "tilt from the zero-phase low-passed accelerometer (heading zero)",
+    ),
+    Method(
+        "davenport",
+        vector_observation,
+        "offline",
+        "accelerometer + magnetometer, no gyroscope: Davenport's q-method per sample "
+        "(optionally low-passed first)",
+        requires_mag=True,
     ),
     Method(
         "complementary",
@@ -258,11 +368,76 @@ METHODS: Mapping[str, Method] = _registry(
 )
 
 
-def methods(kind: str | None = None) -> tuple[str, ...]:
-    """Names of the registered methods (of one ``kind`` if given)."""
+def _available(needs: Any) -> frozenset[str]:
+    """The sensor variables named by ``needs`` (a name, names, or a Recording)."""
+    if isinstance(needs, Mapping) or hasattr(needs, "data_vars"):
+        return frozenset(v for v in SENSORS if v in needs)
+    names = (needs,) if isinstance(needs, str) else tuple(needs)
+    out = set()
+    for name in names:
+        parts = [p.strip() for p in str(name).replace("+", ",").split(",")]
+        out.update(p for p in parts if p)
+    unknown = sorted(out - set(SENSORS))
+    if unknown:
+        raise ValueError(
+            f"needs: unknown sensor variable(s) {unknown}; use names of {SENSORS}, "
+            'e.g. needs="acc" or needs=("acc", "mag"), or pass a Recording'
+        )
+    return frozenset(out)
+
+
+def methods(kind: str | None = None, *, needs: Any = None) -> tuple[str, ...]:
+    """Names of the registered methods, optionally of one ``kind`` and runnable on the
+    given sensors.
+
+    Parameters
+    ----------
+    kind : {"causal", "offline", "adapter"}, optional
+        Keep only the methods of this kind.
+    needs : str, sequence of str or xarray.Dataset, optional
+        The sensor variables available (``"acc"``, ``("acc", "mag")``, ``"acc+mag"``),
+        or a Recording (its ``acc``, ``gyr``, ``mag``): keep only the methods that need
+        nothing more (:attr:`Method.needs`).
+
+    Returns
+    -------
+    tuple of str
+
+    Examples
+    --------
+    >>> methods(needs="acc")
+    ('lowpass',)
+    >>> methods(needs="acc+mag")
+    ('lowpass', 'davenport')
+    """
     if kind is not None and kind not in KINDS:
         raise ValueError(f"kind must be one of {KINDS}, got {kind!r}")
-    return tuple(n for n, m in METHODS.items() if kind is None or m.kind == kind)
+    have = None if needs is None else _available(needs)
+    return tuple(
+        n
+        for n, m in METHODS.items()
+        if (kind is None or m.kind == kind) and (have is None or set(m.needs) <= have)
+    )
+
+
+def missing_sensor_message(method: Method | str, missing: str) -> str:
+    """The message refusing ``method`` on data without the variable ``missing``: it
+    names the method, what it needs, and the methods that run without that variable."""
+    m = get_method(method) if isinstance(method, str) else method
+    what = {"gyr": "a gyroscope", "mag": "a magnetometer", "acc": "an accelerometer"}
+    others = [
+        n
+        for n, e in METHODS.items()
+        if missing not in e.needs and (missing != "gyr" or "mag" not in e.needs)
+    ]
+    with_mag = [n for n, e in METHODS.items() if missing == "gyr" and e.needs == ("acc", "mag")]
+    alt = ", ".join(repr(n) for n in others) or "none"
+    if with_mag:
+        alt += " (and, with a magnetometer, " + ", ".join(repr(n) for n in with_mag) + ")"
+    return (
+        f"method {m.name!r} needs {what.get(missing, missing)} ({missing!r}), and the "
+        f"data have none; methods that run without it: {alt}"
+    )
 
 
 def get_method(name: str) -> Method:

@@ -9,6 +9,8 @@ Supported formats
 * BROAD benchmark trials, ``.hdf5`` and MATLAB ``.mat`` layouts (``read_broad``).
 * A generic CSV with a column/unit mapping (``read_csv``), the mapping given as a dict
   or a JSON file (``read_csv_mapping``); time columns in s, ms or µs.
+* One numeric variable of a MATLAB file, v4–v7 or v7.3/HDF5 (``read_matrix``), in
+  MATLAB's own shape.
 * NetCDF via h5netcdf (``save_netcdf`` / ``load_netcdf``), exact round trip
   including attributes of any JSON-serialisable type.
 """
@@ -19,6 +21,7 @@ from ._common import ReadError
 from .broad import read_broad
 from .csv import FS_RANGE, GAP_POLICIES, TIME_UNITS, read_csv, read_csv_mapping
 from .fayat import read_fayat_imu, read_fayat_tumble
+from .mat import read_matrix
 from .netcdf import load_netcdf, save_netcdf
 
 __all__ = [
@@ -33,4 +36,5 @@ __all__ = [
     "GAP_POLICIES",
     "save_netcdf",
     "load_netcdf",
+    "read_matrix",
 ]

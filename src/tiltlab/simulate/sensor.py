@@ -584,6 +584,8 @@ def recording_from_motion(
         q_ref=motion.q,
         extra=extra,
         attrs=a,
+        mag_units="uT",
+        temp_units="degC",
     )
 
 

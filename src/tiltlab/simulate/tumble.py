@@ -188,4 +188,8 @@ def tumble_test(
         q_ref=q,
         extra=extra,
         attrs=attrs,
+        acc_units="g",
+        gyr_units="deg/s",
+        mag_units="uT",
+        temp_units="degC",
     )
