@@ -701,18 +701,32 @@ def _rotation_bound(
     turning = good & (tilt > np.radians(GYR_MIN_TILT_DEG))
     unexplained = turning & (turned < tilt / 5.0)
     # does the gyroscope turn about the axis the accelerometer turns about? (its
-    # direction does not depend on the unit label; noise and bias point anywhere)
-    gsum = np.vstack([np.zeros((1, 3)), np.cumsum(np.nan_to_num(gyr_rad_s), axis=0)])
-    rot = gsum[i1] - gsum[i0]
-    axis_acc = np.cross(d[i0], d[i1])
-    mean_g = d[i0] + d[i1]
-    mean_g /= np.maximum(np.linalg.norm(mean_g, axis=1, keepdims=True), 1e-12)
-    rot_perp = rot - np.sum(rot * mean_g, axis=1, keepdims=True) * mean_g
-    denom = np.linalg.norm(axis_acc, axis=1) * np.linalg.norm(rot_perp, axis=1)
-    # signed: for a right-handed frame d0 × d1 = −θ ω̂⊥, so the cosine is near −1 in
-    # every window (near +1 for a left-handed one); noise gives cosines of either sign
-    cos = np.sum(axis_acc * rot_perp, axis=1) / np.maximum(denom, 1e-300)
-    agree = abs(float(np.median(cos[unexplained]))) if unexplained.any() else 0.0
+    # direction does not depend on the unit label; noise and bias point anywhere).
+    # Judged over short steps (0.1 s) inside the unexplained windows, where the
+    # rotation axis is nearly constant.
+    agree = 0.0
+    if unexplained.any():
+        h = max(1, int(round(0.1 * fs)))
+        inside = np.zeros(n, dtype=bool)
+        for k0, k1 in zip(i0[unexplained], i1[unexplained], strict=True):
+            inside[k0 : k1 - h] = True
+        j0 = np.flatnonzero(inside & ok & np.roll(ok, -h))
+        j1 = j0 + h
+        gsum = np.vstack(
+            [np.zeros((1, 3)), np.cumsum(np.nan_to_num(gyr_rad_s), axis=0)]
+        )
+        rot = gsum[j1] - gsum[j0]
+        axis_acc = np.cross(d[j0], d[j1])
+        mean_g = d[j0] + d[j1]
+        mean_g /= np.maximum(np.linalg.norm(mean_g, axis=1, keepdims=True), 1e-12)
+        rot_perp = rot - np.sum(rot * mean_g, axis=1, keepdims=True) * mean_g
+        size = np.linalg.norm(axis_acc, axis=1)
+        denom = size * np.linalg.norm(rot_perp, axis=1)
+        # signed: for a right-handed frame d0 × d1 = −θ ω̂⊥, so the cosine is near −1
+        # (near +1 for a left-handed one); noise gives cosines of either sign
+        cos = np.sum(axis_acc * rot_perp, axis=1) / np.maximum(denom, 1e-300)
+        if size.sum() > 0:
+            agree = abs(float(np.sum(cos * size) / size.sum()))
     return int(turning.sum()), int(unexplained.sum()), agree
 
 

@@ -19,6 +19,7 @@ import xarray as xr
 
 from .. import _validate as _v
 from .. import quaternion as quat
+from . import registry
 from .registry import get_method
 
 __all__ = ["Inputs", "prepare", "run", "estimate", "gravity"]
@@ -28,14 +29,14 @@ __all__ = ["Inputs", "prepare", "run", "estimate", "gravity"]
 class Inputs:
     """A Recording's sensor data in SI, ready for the kernels.
 
-    ``acc`` (m/s²) and ``gyr`` (rad/s) as (N, 3) arrays, ``mag`` (its own unit) or
-    ``None``, ``fs`` (Hz) and ``like``: the accelerometer's
-    :class:`tiltlab._validate.Signal`, used to label outputs with the Recording's
-    ``time`` coordinate.
+    ``acc`` (m/s²) as an (N, 3) array, ``gyr`` (rad/s) as an (N, 3) array or ``None``
+    (a Recording without a gyroscope), ``mag`` (its own unit) or ``None``, ``fs`` (Hz)
+    and ``like``: the accelerometer's :class:`tiltlab._validate.Signal`, used to label
+    outputs with the Recording's ``time`` coordinate.
     """
 
     acc: np.ndarray
-    gyr: np.ndarray
+    gyr: np.ndarray | None
     mag: np.ndarray | None
     fs: float
     like: _v.Signal
@@ -44,17 +45,27 @@ class Inputs:
     def use_mag(self) -> bool:
         return self.mag is not None
 
+    @property
+    def sensors(self) -> tuple[str, ...]:
+        """The sensor variables read (``acc``, and ``gyr``, ``mag`` when present)."""
+        return (
+            ("acc",)
+            + (("gyr",) if self.gyr is not None else ())
+            + (("mag",) if self.mag is not None else ())
+        )
+
 
 def prepare(
     recording: xr.Dataset, *, use_mag: bool = False, allow_nan: bool = False
 ) -> Inputs:
-    """Read a Recording's ``acc``, ``gyr`` (and ``mag``) in SI units.
+    """Read a Recording's ``acc``, ``gyr`` when it has one (and ``mag``) in SI units.
 
     Parameters
     ----------
     recording : xarray.Dataset
-        A tiltlab Recording: ``acc`` and ``gyr`` (time, axis) with ``units`` attrs,
-        optional ``mag``; attrs ``fs``.
+        A tiltlab Recording: ``acc`` (time, axis) with a ``units`` attr, optional
+        ``gyr`` (read when present; ``Inputs.gyr`` is ``None`` otherwise, and the
+        methods that need it refuse by name in :func:`run`) and ``mag``; attrs ``fs``.
     use_mag : bool
         Also read ``mag`` (9D).
     allow_nan : bool
@@ -80,7 +91,8 @@ def prepare(
             "recording must be an xarray Dataset (a tiltlab Recording), "
             f"got {type(recording).__name__}"
         )
-    names = ["acc", "gyr"] + (["mag"] if use_mag else [])
+    names = ["acc"] + (["gyr"] if "gyr" in recording else [])
+    names += ["mag"] if use_mag else []
     for name in names:
         if name not in recording:
             hint = " (needed for use_mag=True)" if name == "mag" else ""
@@ -89,23 +101,39 @@ def prepare(
     if "time" in rec.dims:
         rec = rec.transpose("time", ...)
     acc = _v.signal(rec, "acc", to_units="m/s^2", allow_nan=allow_nan)
-    gyr = _v.signal(rec, "gyr", to_units="rad/s", allow_nan=allow_nan)
+    gyr = (
+        _v.signal(rec, "gyr", to_units="rad/s", allow_nan=allow_nan).values
+        if "gyr" in names
+        else None
+    )
     mag = _v.signal(rec, "mag", allow_nan=allow_nan).values if use_mag else None
 
     def c(a):
         return None if a is None else np.ascontiguousarray(a, dtype=np.float64)
 
-    return Inputs(c(acc.values), c(gyr.values), c(mag), acc.fs, acc)
+    return Inputs(c(acc.values), c(gyr), c(mag), acc.fs, acc)
+
+
+def _check_sensors(m, inputs: Inputs) -> None:
+    """Refuse a method whose sensor the prepared data lack, naming the methods that run."""
+    for name in m.needs:
+        if name not in inputs.sensors:
+            raise _v.RecordingError(
+                registry.missing_sensor_message(m, name, inputs.sensors)
+            )
 
 
 def run(method: str, inputs: Inputs, **params) -> np.ndarray:
     """Run a registered method on prepared :class:`Inputs`; returns (N, 4) quaternions.
 
     Unspecified parameters take the registry's defaults; an unknown method or
-    parameter is a ValueError naming it.
+    parameter is a ValueError naming it; a method that needs a sensor the inputs lack
+    (a gyroscope, a magnetometer) is a :class:`~tiltlab._validate.RecordingError` naming
+    it and the methods that would run.
     """
     m = get_method(method)
     full = m.resolve(params)
+    _check_sensors(m, inputs)
     return m(inputs.acc, inputs.gyr, inputs.fs, inputs.mag, **full)
 
 

@@ -32,6 +32,10 @@ from dataclasses import dataclass
 from types import MappingProxyType
 from typing import Any
 
+import numpy as np
+
+from .. import _validate as _v
+from .. import dsp
 from . import adapters
 from .complementary import complementary
 from .ekf import ekf
@@ -189,13 +193,14 @@ class Method:
                 "use_mag=True is not supported"
             )
         if mag is None and self.requires_mag:
-            raise ValueError(missing_sensor_message(self, "mag"))
+            raise ValueError(missing_sensor_message(self, "mag", ("acc",)))
         kw = dict(params)
         if mag is not None:
             kw["mag"] = mag
         if self.uses_gyr:
             if gyr is None:
-                raise ValueError(missing_sensor_message(self, "gyr"))
+                have = ("acc", "mag") if mag is not None else ("acc",)
+                raise ValueError(missing_sensor_message(self, "gyr", have))
             return self.function(acc, gyr, fs, **kw)
         return self.function(acc, fs, **kw)
 
@@ -250,9 +255,6 @@ def vector_observation(
        Determination and Control*, Springer, 2014, §5.5.
        doi:10.1007/978-1-4939-0802-8
     """
-    from .. import _validate as _v
-    from .. import dsp
-
     fs = _v.check_fs(fs)
     a = _v.vectors(acc, "acc", width=3, ndim=2)
     m = _v.vectors(mag, "mag", width=3, ndim=2)
@@ -420,23 +422,28 @@ def methods(kind: str | None = None, *, needs: Any = None) -> tuple[str, ...]:
     )
 
 
-def missing_sensor_message(method: Method | str, missing: str) -> str:
-    """The message refusing ``method`` on data without the variable ``missing``: it
-    names the method, what it needs, and the methods that run without that variable."""
+def missing_sensor_message(
+    method: Method | str, missing: str, have: Collection[str] = ("acc",)
+) -> str:
+    """The message refusing ``method`` on data without the variable ``missing``.
+
+    It names the method and the sensor it needs, and lists the methods that run on the
+    variables ``have`` (and those that would with a magnetometer too).
+    """
     m = get_method(method) if isinstance(method, str) else method
     what = {"gyr": "a gyroscope", "mag": "a magnetometer", "acc": "an accelerometer"}
-    others = [
-        n
-        for n, e in METHODS.items()
-        if missing not in e.needs and (missing != "gyr" or "mag" not in e.needs)
-    ]
-    with_mag = [n for n, e in METHODS.items() if missing == "gyr" and e.needs == ("acc", "mag")]
-    alt = ", ".join(repr(n) for n in others) or "none"
-    if with_mag:
-        alt += " (and, with a magnetometer, " + ", ".join(repr(n) for n in with_mag) + ")"
+    have = set(have) - {missing}
+    ok = methods(needs=sorted(have)) if have else ()
+    alt = ", ".join(repr(n) for n in ok) or "none"
+    if "mag" not in have:
+        more = [n for n in methods(needs=sorted(have | {"mag"})) if n not in ok]
+        if more:
+            alt += "; with a magnetometer also " + ", ".join(repr(n) for n in more)
+    hint = " (it reads the Recording's 'mag' variable)" if missing == "mag" else ""
     return (
-        f"method {m.name!r} needs {what.get(missing, missing)} ({missing!r}), and the "
-        f"data have none; methods that run without it: {alt}"
+        f"method {m.name!r} needs {what.get(missing, repr(missing))} ({missing!r}) and "
+        f"the data have none{hint}; methods that run on {', '.join(sorted(have))}: "
+        f"{alt}"
     )
 
 
