@@ -3277,7 +3277,13 @@ def test_fuzz_make_recording(data):
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            rec = schema.make_recording(acc, gyr, fs, **kw)
+            units = {
+                "acc_units": "g",
+                "gyr_units": "deg/s",
+                "mag_units": "uT",
+                "temp_units": "degC",
+            }
+            rec = schema.make_recording(acc, gyr, fs, **{**units, **kw})
     except (RecordingError, ValueError) as exc:
         _outcome(f"error {type(exc).__name__}")
         assert _NAMES.search(str(exc)), f"{type(exc).__name__}: {exc}"

@@ -461,7 +461,7 @@ def test_mounting_rotation_levels_rest_acceleration():
 def _rec(rng, n=600, **kw):
     acc = np.tile([0.0, 0.0, 1.0], (n, 1)) + rng.normal(0, 0.003, (n, 3))
     gyr = rng.normal(0, 0.1, (n, 3))
-    return schema.make_recording(acc, gyr, FS, **kw)
+    return schema.make_recording(acc, gyr, FS, acc_units="g", gyr_units="deg/s", **kw)
 
 
 def test_calibration_json_and_double_application():
@@ -526,7 +526,7 @@ def test_temperature_calibration_needs_temp():
     with pytest.raises(C.CalibrationError, match="temp"):
         C.calibrate(rec, C.Calibration(acc_temp=model))
     temp = np.linspace(29, 33, 600)
-    rec_t = _rec(rng, temp=temp)
+    rec_t = _rec(rng, temp=temp, temp_units="degC")
     out = C.calibrate(rec_t, C.Calibration(acc_temp=model))
     np.testing.assert_allclose(
         rec_t.acc.values[:, 0] - out.acc.values[:, 0], 0.001 * (temp - 31), atol=1e-12

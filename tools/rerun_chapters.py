@@ -10,7 +10,9 @@ chapter's rerun is described by ``tools/reruns/<notebook stem>.py``, which defin
 
 and optionally ``check(nb_path: Path, params: dict) -> str``, which compares a number the
 executed chapter printed with the package computing it directly, so that a rerun cannot
-silently analyse the wrong thing. Every chapter must have a rerun module.
+silently analyse the wrong thing. Every chapter must have a rerun module. A module may
+also define ``VARIANTS``: a dict of further reruns, name → ``prepare`` function (with an
+optional ``check_<name>``), e.g. the chapter on a converted recording from another lab.
 
 Usage: ``python tools/rerun_chapters.py [NOTEBOOK_STEM ...]``
 """
@@ -48,6 +50,15 @@ def reruns() -> list[tuple[str, object]]:
     return out
 
 
+def _jobs(stem: str, module) -> list[tuple[str, object, object]]:
+    """(label, prepare-or-params, check) for the module's main rerun and its variants."""
+    main = module.prepare if hasattr(module, "prepare") else dict(module.PARAMS)
+    jobs = [(stem, main, getattr(module, "check", None))]
+    for name, prep in getattr(module, "VARIANTS", {}).items():
+        jobs.append((f"{stem} [{name}]", prep, getattr(module, f"check_{name}", None)))
+    return jobs
+
+
 def main(argv: list[str]) -> int:
     wanted = set(argv)
     failures = ran = 0
@@ -55,30 +66,34 @@ def main(argv: list[str]) -> int:
         for stem, module in reruns():
             if wanted and stem not in wanted:
                 continue
-            ran += 1
-            out = Path(tmp) / f"{stem}.rerun.ipynb"
-            t0 = time.perf_counter()
-            try:
-                if hasattr(module, "prepare"):
-                    print(f"== {stem}: preparing its data", flush=True)
-                    params = module.prepare(Path(tmp))
-                else:
-                    params = dict(module.PARAMS)
-                print(f"== {stem} with {params}", flush=True)
-                pm.execute_notebook(
-                    str(NOTEBOOKS / f"{stem}.ipynb"),
-                    str(out),
-                    parameters=params,
-                    cwd=str(NOTEBOOKS),
-                    kernel_name="python3",
-                    progress_bar=False,
-                )
-                check = getattr(module, "check", None)
-                note = check(out, params) if check else "completed"
-                print(f"   ok in {time.perf_counter() - t0:.0f} s: {note}", flush=True)
-            except Exception as exc:  # report every rerun, then fail
-                failures += 1
-                print(f"   FAILED: {type(exc).__name__}: {exc}", flush=True)
+            for label, how, check in _jobs(stem, module):
+                ran += 1
+                work = Path(tmp) / label.replace(" ", "_").strip("[]")
+                work.mkdir(parents=True, exist_ok=True)
+                out = work / f"{stem}.rerun.ipynb"
+                t0 = time.perf_counter()
+                try:
+                    if callable(how):
+                        print(f"== {label}: preparing its data", flush=True)
+                        params = how(work)
+                    else:
+                        params = dict(how)
+                    print(f"== {label} with {params}", flush=True)
+                    pm.execute_notebook(
+                        str(NOTEBOOKS / f"{stem}.ipynb"),
+                        str(out),
+                        parameters=params,
+                        cwd=str(NOTEBOOKS),
+                        kernel_name="python3",
+                        progress_bar=False,
+                    )
+                    note = check(out, params) if check else "completed"
+                    print(
+                        f"   ok in {time.perf_counter() - t0:.0f} s: {note}", flush=True
+                    )
+                except Exception as exc:  # report every rerun, then fail
+                    failures += 1
+                    print(f"   FAILED: {type(exc).__name__}: {exc}", flush=True)
     print(f"{ran - failures} passed, {failures} failed")
     return 1 if failures else 0
 
