@@ -398,6 +398,7 @@ def test_estimate_converts_units_and_records_params(method):
 
 ALL_METHODS = {
     "lowpass",
+    "davenport",
     "complementary",
     "madgwick",
     "mahony",

@@ -25,7 +25,11 @@ NEEDS = {
     "ahrs_mahony": ("ahrs",),
     "ahrs_ekf": ("ahrs",),
 }
-MAG_METHODS = [n for n in F.methods() if get_method(n).supports_mag]
+MAG_METHODS = [
+    n
+    for n in F.methods()
+    if get_method(n).supports_mag and not get_method(n).requires_mag
+]
 
 
 def _need(method):
@@ -70,6 +74,7 @@ def _gapped(method, mag=False):
     m = int(round(_segment_s(method) * FS))
     t, acc, gyr, mg = _motion(2 * m + 100)
     keep = np.r_[0:m, m + 100 : 2 * m + 100]
+    mag = mag or get_method(method).requires_mag
     rec = _recording(acc[keep], gyr[keep], t[keep], mg[keep] if mag else None)
     return rec, [(0, m), (m, 2 * m)]
 
@@ -81,6 +86,7 @@ def _with_nan(method, var="acc", mag=False):
     data = {"acc": acc, "gyr": gyr, "mag": mg}
     data[var] = data[var].copy()
     data[var][m : m + 100, 1] = np.nan
+    mag = mag or get_method(method).requires_mag
     rec = _recording(data["acc"], data["gyr"], t, data["mag"] if mag else None)
     return rec, [(0, m), (m + 100, 2 * m + 100)]
 

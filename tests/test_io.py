@@ -164,9 +164,13 @@ def test_netcdf_round_trip_is_exact(tmp_path):
         Q.gravity(q),
         rng.normal(0, 1, (n, 3)),
         200.0,
+        acc_units="g",
+        gyr_units="rad/s",
         q_ref=q,
         mag=rng.normal(0, 30, (n, 3)),
+        mag_units="uT",
         temp=25 + rng.normal(0, 0.1, n),
+        temp_units="degC",
         extra={
             "moving": ("time", rng.random(n) > 0.5, {"long_name": "a mask"}),
             "state": (
@@ -291,7 +295,7 @@ def test_csv_implausible_fs_suggests_the_time_unit(tmp_path):
     _lab_csv(p)
     m = {k: v for k, v in MAPPING.items() if k != "time_units"}
     # time column read as seconds: 0.3 Hz, and the message says it is probably ms
-    with pytest.raises(ValueError, match=r"0\.3 Hz.*time_units='ms'.*300 Hz"):
+    with pytest.raises(ValueError, match=r'0\.3 Hz.*"time_units": "ms".*300 Hz'):
         io.read_csv(p, mapping=m)
     # an fs that the time column contradicts
     with pytest.raises(ValueError, match="fs = 300 Hz but time column 't_ms'"):
@@ -356,7 +360,8 @@ def test_csv_time_unit_hint_names_the_unit(tmp_path, factor, unit, name, given):
     m = {k: v for k, v in MAPPING.items() if k != "time_units"}
     if given:
         m["time_units"] = given
-    expected = f"the time column looks like {name}: give time_units='{unit}'"
+    # the options come from a mapping: the fix is named as its JSON key
+    expected = f'the time column looks like {name}: give "time_units": "{unit}"'
     with pytest.raises(ValueError, match=rf"outside the plausible range.*{expected}"):
         io.read_csv(p, mapping=m)
     with pytest.raises(ValueError, match=rf"fs = 100 Hz but .*{expected}"):
@@ -425,9 +430,18 @@ def test_csv_dropped_samples_are_refused_or_kept_as_nan(tmp_path):
     p.write_text("".join(lines[:201] + lines[206:]))
     with pytest.raises(
         schema.RecordingError,
-        match=r"skips samples \(1 gap: 0\.05 s at t = .*gaps='nan'",
+        match=r'skips samples \(1 gap: 0\.05 s at t = .*"gaps": "nan"',
     ):
         io.read_csv(p, mapping=MAPPING)
+    # the same hint as a keyword when the options are keywords
+    with pytest.raises(schema.RecordingError, match=r"skips samples .*gaps='nan'"):
+        io.read_csv(
+            p,
+            MAPPING["columns"],
+            MAPPING["units"],
+            time_column="t_ms",
+            time_units="ms",
+        )
     rec = io.read_csv(p, mapping={**MAPPING, "gaps": "nan"})
     assert rec.sizes["time"] == 600 and rec.attrs["fs"] == pytest.approx(100.0)
     assert np.isnan(rec.acc.values[200:205]).all()

@@ -1,4 +1,4 @@
-"""``tiltlab`` command line: inspect, validate and fetch data; run cohorts.
+"""``tiltlab`` command line: inspect, validate, convert and fetch data; run cohorts.
 
 Examples
 --------
@@ -6,18 +6,26 @@ Examples
 
     tiltlab fetch --all                # download (or verify in the mirror) every registered file
     tiltlab info broad:2               # summary of BROAD trial 2
+    tiltlab info deployment.nc         # what a file looks like (tag-tools NetCDF …) and its summary
     tiltlab validate session.nc        # check a saved Recording against the contract
     tiltlab info my_session.csv --mapping mapping.json   # your own CSV, with a column mapping
+    tiltlab convert deployment.nc --out session.nc       # tag-tools NetCDF → Recording
+    tiltlab convert my_session.csv --mapping mapping.json --out session.nc
+    tiltlab convert board/ --mapping files.json --out session.nc  # one file per sensor
     tiltlab cohort init data/ --pattern "{group}/{subject}_{timepoint}.nc" --out manifest.csv
     tiltlab cohort run manifest.csv --out features.nc --workers 2
     tiltlab cohort show features.nc
 
 Every user error (missing file, bad JSON, bad mapping, a Recording that breaks the
 contract) is reported as one line ``tiltlab: ...`` on stderr with a non-zero exit
-status, never as a traceback (set ``TILTLAB_DEBUG=1`` to see one). Quality warnings
-(clipped samples, values doubtful for their units: :mod:`tiltlab.quality`) are printed
-by ``tiltlab validate`` as lines ``warning: ...`` before its verdict, and leave the exit
-status 0.
+status, never as a traceback (set ``TILTLAB_DEBUG=1`` to see one). A file that is not
+a tiltlab Recording (a tag-tools NetCDF, a MATLAB file …) is named for what it looks
+like, with the command that converts it. Values that decisively contradict their unit
+labels are refused; ``--no-check-units`` (on ``info``, ``validate``, ``convert`` and
+``cohort run``) accepts the labels as they are — in a cohort manifest the same switch
+is ``reader_options {"check_units": false}``. Quality warnings (clipped samples,
+values doubtful for their units: :mod:`tiltlab.quality`) are printed by ``tiltlab
+validate`` and ``tiltlab convert`` as lines ``warning: ...``, and leave the exit status 0.
 """
 
 from __future__ import annotations
@@ -47,12 +55,23 @@ A mapping is a JSON file telling tiltlab which columns hold what, in which units
                 "temp": "T"},
     "units": {"acc": "g", "gyr": "deg/s", "temp": "degC"},
     "time_column": "t_ms", "time_units": "ms",
+    "preset": "android",
     "sep": ";"
   }
 
-"columns" and "units" are required ("acc" and "gyr"; "mag", "temp", "q_ref" optional);
-give "fs" (Hz) or a "time_column" (its unit "s", "ms" or "us" in "time_units"); any
-other key is a pandas.read_csv option (sep, decimal, skiprows, comment, encoding ...)."""
+"columns" and "units" are required; "acc" is the only required variable ("gyr",
+"mag", "temp", "q_ref" are optional: accelerometer-only tags are fine). Give "fs" (Hz)
+or a "time_column" (its unit "s", "ms" or "us" in "time_units"; "clock": "resample"
+puts an irregular clock on a regular grid). "axes" (e.g. ["x", "-y", "z"], or per
+variable) or "preset" (android, ios, tagtools, animal ...) map the device's axes into
+the sensor frame; "check_units": false accepts the unit labels as they are (the same as
+--no-check-units). With "files" instead of "columns", each sensor comes from its own
+file (one file per sensor, e.g. MATLAB .mat matrices), read by tiltlab.io.read_multi;
+their paths are relative to the mapping's folder. Any other key is a pandas.read_csv
+option (sep, decimal, skiprows, comment, encoding ...).
+
+Files tiltlab reads without a mapping: NetCDF Recordings, tag-tools (animaltags)
+NetCDF archives (NetCDF-4 or -3), BROAD trials (.hdf5, .mat)."""
 
 _NO_MAPPING = (
     "don't know how to read {source!r} without a column mapping: give "
@@ -99,23 +118,45 @@ def _message(exc: BaseException) -> str:
     return text
 
 
-def _load(source: str, mapping: str | None = None, *, cmd: str = "info"):
-    """A Recording from a data-source string, or from a CSV with a mapping."""
-    from . import datasets, io
+def _load(
+    source: str,
+    mapping: str | None = None,
+    *,
+    cmd: str = "info",
+    check_units: bool = True,
+    **options: Any,
+):
+    """A Recording from a data-source string, or from a CSV with a mapping.
 
-    if mapping is not None:
-        return io.read_csv(source, mapping=mapping)
-    if Path(source).suffix.lower() in _CSV_SUFFIXES:
-        raise UserError(_NO_MAPPING.format(source=source, cmd=cmd))
+    A refusal of the unit check names ``--no-check-units``."""
+    from . import datasets, io
+    from .quality import UnitCheckError
+
+    opts = dict(options)
+    if not check_units:
+        opts["check_units"] = False
     try:
-        return datasets.load(source)
-    except datasets.DataError as exc:
-        if str(exc).startswith("don't know how to read"):
-            raise UserError(
-                f"{exc}; for your own CSV give --mapping mapping.json "
-                f"(see 'tiltlab {cmd} --help')"
-            ) from None
-        raise
+        if mapping is not None:
+            if not Path(mapping).is_file():
+                raise UserError(f"{mapping}: no such mapping file")
+            return io.read(source, mapping=mapping, **opts)
+        if Path(source).suffix.lower() in _CSV_SUFFIXES:
+            raise UserError(_NO_MAPPING.format(source=source, cmd=cmd))
+        try:
+            return datasets.load(source, **opts)
+        except datasets.DataError as exc:
+            if str(exc).startswith("don't know how to read"):
+                what = ""
+                if Path(source).is_file():
+                    with contextlib.suppress(OSError):
+                        what = f" (it looks like: {io.detect(source)})"
+                raise UserError(
+                    f"{exc}{what}; for your own CSV give --mapping mapping.json "
+                    f"(see 'tiltlab {cmd} --help')"
+                ) from None
+            raise
+    except UnitCheckError as err:
+        raise err.for_switch("cli") from None
 
 
 def _read_json(path: str, what: str) -> Any:
@@ -199,30 +240,97 @@ def _quality_lines(emit):
             emit(text)
 
 
+def _looks_like(source: str) -> str | None:
+    """What a file source looks like (:func:`tiltlab.io.detect`), None for names."""
+    from . import io
+
+    if not Path(source).is_file():
+        return None
+    try:
+        return io.detect(source)
+    except OSError:
+        return None
+
+
 def _cmd_info(args: argparse.Namespace) -> int:
     from . import schema
 
+    what = None if args.mapping else _looks_like(args.source)
     with _quality_lines(lambda t: print(f"tiltlab: warning: {t}", file=sys.stderr)):
-        rec = _load(args.source, args.mapping, cmd="info")
+        rec = _load(args.source, args.mapping, cmd="info", check_units=args.check_units)
+    if what is not None:
+        print(f"{'file':>14}: {what}")
     for k, v in schema.describe(rec).items():
         print(f"{k:>14}: {v}")
     if "fs_source" in rec.attrs:
         print(f"{'fs_source':>14}: {rec.attrs['fs_source']}")
+    if what is not None and not what.startswith("tiltlab Recording"):
+        print(
+            f"{'convert':>14}: tiltlab convert {args.source} --out session.nc"
+            + (" --no-check-units" if not args.check_units else "")
+        )
     return EXIT_OK
 
 
 def _cmd_validate(args: argparse.Namespace) -> int:
-    from . import schema
+    from . import io, schema
+    from .quality import UnitCheckError
 
+    what = None
+    if args.mapping is None and Path(args.source).suffix.lower() not in _CSV_SUFFIXES:
+        what = _looks_like(args.source)
+    if what is not None and not what.startswith(("tiltlab Recording", "BROAD")):
+        # a file read by conversion is not a Recording file: say what it is
+        raise io.NotRecordingError(args.source, what)
     # quality warnings are part of the report (stdout), one line each; they do not
     # change the exit status, errors do (one line on stderr, from main)
     with _quality_lines(lambda t: print(f"warning: {t}")) as lines:
-        rec = _load(args.source, args.mapping, cmd="validate")
-        schema.validate(rec, allow_nan=True)
+        rec = _load(
+            args.source, args.mapping, cmd="validate", check_units=args.check_units
+        )
+        try:
+            schema.validate(rec, allow_nan=True, check_units=args.check_units)
+        except UnitCheckError as err:
+            raise err.for_switch("cli") from None
     n = len(lines)
     print(
         f"{args.source}: valid Recording"
         + (f" ({n} warning{'s' if n > 1 else ''})" if n else "")
+    )
+    return EXIT_OK
+
+
+def _cmd_convert(args: argparse.Namespace) -> int:
+    from . import io, schema
+
+    out = Path(args.out)
+    if out.is_dir():
+        raise UserError(f"--out {out} is a folder; give a file such as session.nc")
+    if out.suffix.lower() not in (".nc", ".nc4", ".netcdf"):
+        raise UserError(f"--out {out}: a Recording is written as NetCDF; end it in .nc")
+    if out.exists() and not args.force:
+        raise UserError(f"{out} exists; give another --out, or --force to replace it")
+    src = Path(args.source)
+    if src.resolve() == out.resolve():
+        raise UserError(f"--out {out} is the source itself; give another file")
+    what = None if args.mapping else _looks_like(args.source)
+    options: dict[str, Any] = {}
+    if args.preset is not None:
+        options["preset"] = args.preset
+    with _quality_lines(lambda t: print(f"warning: {t}")):
+        rec = _load(
+            args.source,
+            args.mapping,
+            cmd="convert",
+            check_units=args.check_units,
+            **options,
+        )
+    io.save_netcdf(rec, out)
+    d = schema.describe(rec)
+    variables = ", ".join(str(v) for v in rec.data_vars)
+    print(
+        f"wrote {out}: {rec.sizes['time']} samples at {rec.attrs['fs']:g} Hz "
+        f"({d['duration_s']:g} s; {variables})" + (f" from a {what}" if what else "")
     )
     return EXIT_OK
 
@@ -296,6 +404,20 @@ def _cohort_inputs(args: argparse.Namespace):
     return manifest, config
 
 
+def _without_unit_check(manifest):
+    """The manifest with ``"check_units": false`` in every row's reader_options."""
+    import dataclasses
+
+    table = manifest.table.copy()
+    rows = []
+    for text in table.get("reader_options", [""] * len(table)):
+        opts = json.loads(text) if str(text or "").strip() else {}
+        opts["check_units"] = False
+        rows.append(json.dumps(opts, sort_keys=True))
+    table["reader_options"] = rows
+    return dataclasses.replace(manifest, table=table)
+
+
 def _scheduler(text: str) -> str:
     """An argparse type for ``--scheduler``: ``dask``, ``processes`` or an address."""
     if text in ("dask", "processes") or "://" in text:
@@ -310,6 +432,8 @@ def _cmd_cohort_run(args: argparse.Namespace) -> int:
     from . import cohort
 
     manifest, config = _cohort_inputs(args)
+    if not args.check_units:
+        manifest = _without_unit_check(manifest)
     out = Path(args.out)
     if out.is_dir():
         raise UserError(
@@ -434,6 +558,16 @@ def _config_of(features) -> dict | None:
 # --------------------------------------------------------------------------- parser
 
 
+def _add_check_units(p: argparse.ArgumentParser, where: str = "") -> None:
+    p.add_argument(
+        "--no-check-units",
+        dest="check_units",
+        action="store_false",
+        help="accept the unit labels as they are, even where the values contradict "
+        "them (the unit check refuses, e.g., m/s² values labelled g)" + where,
+    )
+
+
 def _parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="tiltlab",
@@ -466,8 +600,36 @@ def _parser() -> argparse.ArgumentParser:
         p.add_argument(
             "--mapping",
             metavar="MAPPING.json",
-            help="column/unit mapping (JSON) for a generic CSV file",
+            help="column/unit mapping (JSON) for a generic CSV file, or a multi-file "
+            'mapping with "files"',
         )
+        _add_check_units(p)
+    p_conv = sub.add_parser(
+        "convert",
+        help="convert a file into a NetCDF Recording",
+        description="Convert SOURCE into a validated NetCDF Recording (tiltlab.io.read "
+        "then tiltlab.io.save_netcdf): a tag-tools NetCDF archive, a BROAD trial, a "
+        "tiltlab NetCDF, your own CSV with --mapping, or one file per sensor with a "
+        'mapping that has "files" (SOURCE is then the folder of those files). Prints '
+        "one summary line, after any quality warnings ('warning: ...').",
+        epilog=_MAPPING_HELP,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    p_conv.add_argument("source", metavar="SOURCE", help="file (or folder) to convert")
+    p_conv.add_argument(
+        "--mapping", metavar="MAPPING.json", help="column/unit or multi-file mapping"
+    )
+    p_conv.add_argument("--out", required=True, help="Recording to write (.nc)")
+    p_conv.add_argument(
+        "--preset",
+        metavar="NAME",
+        help="device axes convention (android, ios, tagtools, animal ...), for sources "
+        "whose axes are not in the sensor frame yet",
+    )
+    p_conv.add_argument(
+        "--force", action="store_true", help="replace an existing --out file"
+    )
+    _add_check_units(p_conv)
 
     p_cohort = sub.add_parser("cohort", help="cohort manifests and features")
     csub = p_cohort.add_subparsers(dest="cohort_cmd", required=True, metavar="COMMAND")
@@ -527,6 +689,10 @@ def _parser() -> argparse.ArgumentParser:
     p_run.add_argument("--config", metavar="CONFIG.json", help="feature configuration")
     p_run.add_argument("--cache-dir", metavar="DIR", help="per-session feature cache")
     p_run.add_argument("--no-progress", action="store_true", help="no progress bar")
+    _add_check_units(
+        p_run,
+        ' for every session (in a manifest row: reader_options {"check_units": false})',
+    )
 
     p_show = csub.add_parser(
         "show",
@@ -570,6 +736,8 @@ def main(argv: Sequence[str] | None = None) -> int:
             return _cmd_info(args)
         if args.cmd == "validate":
             return _cmd_validate(args)
+        if args.cmd == "convert":
+            return _cmd_convert(args)
         if args.cmd == "cohort":
             return {
                 "init": _cmd_cohort_init,

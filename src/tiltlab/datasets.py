@@ -221,15 +221,20 @@ def load_fayat_tumble() -> xr.Dataset:
     return io.read_fayat_tumble(fetch("fayat2021/example_sensor_calibration.csv"))
 
 
-def load(source: str | os.PathLike) -> xr.Dataset:
+def load(source: str | os.PathLike, **options) -> xr.Dataset:
     """Load a Recording from a data-source string: the one entry point chapters and the CLI use.
 
     Parameters
     ----------
     source : str or path
         ``"broad:N"`` (BROAD trial N), ``"fayat:example"`` (rat head IMU, 100 Hz),
-        ``"fayat:tumble"`` (tumble test, 300 Hz), or a file: NetCDF (``.nc``) written by
-        :func:`tiltlab.io.save_netcdf`, or a BROAD-layout ``.hdf5``/``.h5``/``.mat`` file.
+        ``"fayat:tumble"`` (tumble test, 300 Hz), or a file that :func:`tiltlab.io.read`
+        recognises from its content: a NetCDF Recording written by
+        :func:`tiltlab.io.save_netcdf`, a tag-tools NetCDF archive, or a BROAD-layout
+        ``.hdf5``/``.h5``/``.mat`` file.
+    **options
+        For files: reader options of :func:`tiltlab.io.read` (``check_units=False``
+        accepts unit labels as they are; ``axes``, ``preset`` for tag-tools files).
 
     Returns
     -------
@@ -256,15 +261,11 @@ def load(source: str | os.PathLike) -> xr.Dataset:
         return load_fayat_tumble()
     path = Path(spec)
     suffix = path.suffix.lower()
-    if suffix in (".nc", ".netcdf"):
+    if suffix in (".nc", ".netcdf", ".nc4", ".cdf", ".hdf5", ".h5", ".mat"):
         if not path.exists():
             raise DataError(f"source {spec!r}: no such file")
-        return io.load_netcdf(path)
-    if suffix in (".hdf5", ".h5", ".mat"):
-        if not path.exists():
-            raise DataError(f"source {spec!r}: no such file")
-        return io.read_broad(path)
+        return io.read(path, **options)
     raise DataError(
         f"don't know how to read {spec!r}: use broad:N, fayat:example, fayat:tumble, "
-        "or a .nc / .hdf5 / .mat file"
+        "or a .nc / .hdf5 / .mat file (tiltlab.io.detect says what a file looks like)"
     )

@@ -3,11 +3,16 @@ activity.
 
 * :mod:`~tiltlab.behavior.speed` — angular speed, its still/moving modes and valley,
   gyroscope spectrum, realism table (Fayat et al. 2021 §2.9, Fig. A3);
-* :mod:`~tiltlab.behavior.immobility` — Fayat's immobility mask (§2.9) on
-  :func:`tiltlab.dsp.still_mask`;
+* :mod:`~tiltlab.behavior.immobility` — immobility on :func:`tiltlab.dsp.still_mask`:
+  Fayat's gyroscope rule (§2.9), or a VeDBA rule on recordings without a gyroscope
+  (:func:`immobility` picks the rule from the data and records it in its attrs);
 * :mod:`~tiltlab.behavior.circling` — azimuthal speed and circling index (§2.10);
 * :mod:`~tiltlab.behavior.activity` — static acceleration, DBA/ODBA, one value per step
   (Benhamou 2023 §2, §9).
+
+Without a gyroscope (most bio-logging tags), activity (DBA/ODBA) and immobility (its
+accelerometer rule) are computed; angular speed, its spectrum and circling need the
+angular velocity and refuse such a Recording by name.
 
 Every function that takes per-sample data accepts a Recording (it reads ``gyr`` or
 ``acc``), a labelled DataArray or a plain array with ``fs``/``units`` given explicitly.

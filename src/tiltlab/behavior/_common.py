@@ -15,7 +15,7 @@ from .. import _validate as _v
 from .._validate import output as label
 from .._validate import start_time, windowed
 
-__all__ = ["read", "read_speed", "label", "start_time", "windowed"]
+__all__ = ["read", "read_speed", "label", "start_time", "windowed", "need_gyr"]
 
 #: behavior's reading defaults: (N, 3) finite data; fs only where a function asks for it
 read = functools.partial(_v.signal, need_fs=False)
@@ -41,3 +41,19 @@ def read_speed(speed, fs=None, *, units=None, need_fs: bool = False, allow_nan=F
         ndim=1,
         allow_nan=allow_nan,
     )
+
+
+def need_gyr(data, what: str, instead: str = "") -> None:
+    """Refuse, naming ``what``, a Recording without a gyroscope.
+
+    ``what`` needs the angular velocity (angular speed, circling); a Recording without
+    ``gyr`` (most bio-logging tags) is a :class:`~tiltlab._validate.RecordingError`
+    saying so and what to use ``instead``. Other inputs pass (they are read later).
+    """
+    if isinstance(data, xr.Dataset) and "gyr" not in data:
+        have = ", ".join(v for v in ("acc", "mag") if v in data) or "no sensor"
+        tail = f"; {instead}" if instead else ""
+        raise _v.RecordingError(
+            f"{what} needs a gyroscope: the Recording has no 'gyr' variable "
+            f"(it has {have}){tail}"
+        )

@@ -15,12 +15,18 @@ from __future__ import annotations
 import numpy as np
 
 from .. import _validate as _v
-from ._common import label, read
+from ._common import label, need_gyr, read
 
 __all__ = ["azimuthal_speed", "circling_index"]
 
 
-def _read_pair(gyr, g, units):
+def _read_pair(gyr, g, units, what="azimuthal_speed"):
+    need_gyr(
+        gyr,
+        what,
+        "the rotation about gravity is not observable from an accelerometer; with a "
+        "magnetometer, differentiate the heading (tiltlab.trig) instead",
+    )
     sw = read(gyr, "gyr", units=units, to_units="deg/s", allow_nan=True)
     sg = read(g, "g", var="gravity", allow_nan=True)
     zero = np.sum(sg.values * sg.values, axis=1) == 0  # NaN rows (gaps) pass
@@ -70,7 +76,11 @@ def azimuthal_speed(gyr, g, *, units: str | None = None):
     the sensor z axis with gravity, then takes z). Positive = counter-clockwise seen
     from above.
     """
-    sw, sg = _read_pair(gyr, g, units)
+    return _azimuthal(gyr, g, units, "azimuthal_speed")
+
+
+def _azimuthal(gyr, g, units, what: str):
+    sw, sg = _read_pair(gyr, g, units, what)
     w, gg = sw.values, sg.values
     az = np.sum(w * gg, axis=1) / np.linalg.norm(gg, axis=1)
     return label(az, sw, "azimuthal_speed", "deg/s")
@@ -92,7 +102,7 @@ def circling_index(gyr, g, *, moving=None, units: str | None = None) -> float:
     units : str, optional
         Units of a plain ``gyr``.
     """
-    az = np.asarray(azimuthal_speed(gyr, g, units=units))
+    az = np.asarray(_azimuthal(gyr, g, units, "circling_index"))
     if moving is not None:
         m = np.asarray(moving, dtype=bool)
         if m.shape != az.shape:

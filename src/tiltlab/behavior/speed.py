@@ -14,7 +14,7 @@ from scipy import ndimage, signal
 
 from .. import _validate as _v
 from .. import units as _units
-from ._common import label, read, read_speed
+from ._common import label, need_gyr, read, read_speed
 
 __all__ = [
     "angular_speed",
@@ -26,7 +26,15 @@ __all__ = [
 ]
 
 
-def _read_gyr(gyr, fs, units, *, need_fs=False, allow_nan=True):
+#: what to use instead of a gyroscope-based read-out on an accelerometer-only Recording
+NO_GYRO_HINT = (
+    "on accelerometer-only data use behavior.immobility (its accelerometer rule) and "
+    "behavior.dba for activity"
+)
+
+
+def _read_gyr(gyr, fs, units, *, need_fs=False, allow_nan=True, what="angular speed"):
+    need_gyr(gyr, what, NO_GYRO_HINT)
     return read(
         gyr,
         "gyr",
@@ -81,7 +89,7 @@ def angular_speed(gyr, fs=None, *, units: str | None = None):
     numpy.ndarray or xarray.DataArray (time)
         °/s; a DataArray with ``time``, ``fs`` and ``units="deg/s"`` for labelled input.
     """
-    s = _read_gyr(gyr, fs, units)
+    s = _read_gyr(gyr, fs, units, what="angular_speed")
     return label(_speed(s, np.zeros(3)), s, "angular_speed", "deg/s")
 
 
@@ -217,7 +225,7 @@ def recording_speed(gyr, fs=None, *, units: str | None = None, offset="auto"):
         offset removed (attribute ``gyr_offset_deg_s``).
     """
     need_fs = isinstance(offset, str) and offset == "auto"
-    s = _read_gyr(gyr, fs, units, need_fs=need_fs)
+    s = _read_gyr(gyr, fs, units, need_fs=need_fs, what="recording_speed")
     off = _offset(s, offset)
     factor = _units.conversion_factor(s.units, "deg/s")
     attrs = {"gyr_offset_deg_s": (off * factor).tolist()}
@@ -245,6 +253,7 @@ def gyro_spectrum(
         Power spectral density.
     """
     nperseg_s = _v.positive(nperseg_s, "nperseg_s")
+    need_gyr(gyr, "gyro_spectrum", NO_GYRO_HINT)
     s = read(gyr, "gyr", fs=fs, units=units, to_units="deg/s", need_fs=True)
     g = s.values
     nper = max(min(g.shape[0], int(round(nperseg_s * s.fs))), 1)

@@ -45,7 +45,7 @@ def _plain(v):
 _DRY_FS = 1e5
 
 
-def _dry_run(method, params: dict, use_mag: bool) -> None:
+def _dry_run(method, params: dict, use_mag: bool, where: str = "method_params") -> None:
     """Run ``method`` on a short synthetic static input, so that an out-of-domain
     parameter (a negative cut-off, a NaN gain) is refused when the configuration is
     built, not once per session. Only errors naming a parameter count (the synthetic
@@ -61,9 +61,47 @@ def _dry_run(method, params: dict, use_mag: bool) -> None:
     except ValueError as exc:
         msg = str(exc)
         if any(re.search(rf"\b{re.escape(k)}\b", msg) for k in params):
-            raise ValueError(f"FeatureConfig.method_params: {msg}") from None
+            raise ValueError(f"FeatureConfig.{where}: {msg}") from None
     except Exception:  # noqa: BLE001 - anything else is for the real run to report
         pass
+
+
+def _resolved(method: Any, params: Any, where: str):
+    """The registry entry of ``method`` and its parameters completed with the defaults,
+    typed (a numeric parameter is a finite float) and JSON-serialisable."""
+    name = f"FeatureConfig.{where}"
+    pname = f"FeatureConfig.{where}_params"
+    if not isinstance(method, str):
+        raise ValueError(f"{name} must be a string, got {method!r}")
+    try:
+        m = _filters.get_method(method)
+    except ValueError as exc:
+        raise ValueError(f"{name}: {exc}") from None
+    if not isinstance(params, dict):
+        raise ValueError(f"{pname} must be a dict, got {params!r}")
+    try:
+        resolved = m.resolve(dict(params))
+    except ValueError as exc:
+        raise ValueError(f"{pname}: {exc}") from None
+    defaults = m.defaults
+
+    def typed(k, v):
+        # a numeric parameter must be a finite number; 2 and 2.0 are the same
+        # cut-off: one spelling, one hash
+        d = defaults.get(k)
+        if isinstance(d, (int, float)) and not isinstance(d, bool):
+            x = _v.finite(v, f"{pname}[{k!r}]")
+            return float(x) if isinstance(d, float) else _plain(v)
+        return _plain(v)
+
+    resolved = {k: typed(k, resolved[k]) for k in sorted(resolved)}
+    try:
+        json.dumps(resolved, allow_nan=False)
+    except (TypeError, ValueError):
+        raise ValueError(
+            f"{pname} must hold JSON-serialisable values, got {params!r}"
+        ) from None
+    return m, resolved
 
 
 @dataclass(frozen=True)
@@ -85,6 +123,14 @@ class FeatureConfig:
         construction, so that the stored configuration names every value used.
     use_mag : bool
         Use the magnetometer (9D) where the method supports it.
+    no_gyro_method : str
+        Orientation method for a session whose Recording lacks a sensor that ``method``
+        needs (a bio-logging tag with no gyroscope): one of
+        ``tilt``-capable methods that need no gyroscope
+        (``tiltlab.filters.methods(needs=("acc", "mag"))``). Default ``"lowpass"``, the
+        static-acceleration tilt.
+    no_gyro_method_params : dict
+        Its parameters, completed with the registry's defaults like ``method_params``.
     calibration_model : {"offsets", "ellipsoid"}
         Accelerometer model fitted to a tumble test
         (:func:`tiltlab.calibration.tumble_calibration`): Fayat's offsets, or offsets
@@ -96,7 +142,12 @@ class FeatureConfig:
         Remove the session's gyroscope offset estimated from its quietest windows
         (:func:`tiltlab.calibration.robust_gyro_offset`) before everything else.
     threshold_deg_s, merge_gap_s, min_duration_s : float
-        Immobility rules (Fayat §2.9: 12 °/s, 0.1 s, 0.5 s).
+        Immobility rules (Fayat §2.9: 12 °/s, 0.1 s, 0.5 s); the last two serve the
+        accelerometer rule too.
+    acc_threshold_g, acc_window_s, acc_smooth_s : float
+        Immobility of a session without a gyroscope
+        (:func:`tiltlab.behavior.acc_immobility`): VeDBA threshold (g), static window
+        (s) and running mean (s).
     auto_threshold : bool
         Also compute immobility with the threshold at the valley of the angular-speed
         distribution (:func:`tiltlab.behavior.valley_threshold`).
@@ -117,12 +168,17 @@ class FeatureConfig:
     method: str = "smoother"
     method_params: dict = field(default_factory=dict)
     use_mag: bool = False
+    no_gyro_method: str = "lowpass"
+    no_gyro_method_params: dict = field(default_factory=dict)
     calibration_model: str = "offsets"
     calibration_gyro: bool = False
     gyr_offset: str = "auto"
     threshold_deg_s: float = 12.0
     merge_gap_s: float = 0.1
     min_duration_s: float = 0.5
+    acc_threshold_g: float = 0.03
+    acc_window_s: float = 0.5
+    acc_smooth_s: float = 0.2
     auto_threshold: bool = True
     mesh_n: int = 5000
     visited_min_count: int = 1
@@ -138,40 +194,19 @@ class FeatureConfig:
         def name(f):
             return f"FeatureConfig.{f}"
 
-        if not isinstance(self.method, str):
-            raise ValueError(f"{name('method')} must be a string, got {self.method!r}")
-        try:
-            m = _filters.get_method(self.method)
-        except ValueError as exc:
-            raise ValueError(f"{name('method')}: {exc}") from None
-        if not isinstance(self.method_params, dict):
-            raise ValueError(
-                f"{name('method_params')} must be a dict, got {self.method_params!r}"
-            )
-        try:
-            resolved = m.resolve(dict(self.method_params))
-        except ValueError as exc:
-            raise ValueError(f"{name('method_params')}: {exc}") from None
-        defaults = m.defaults
-
-        def typed(k, v):
-            # a numeric parameter must be a finite number; 2 and 2.0 are the same
-            # cut-off: one spelling, one hash
-            d = defaults.get(k)
-            if isinstance(d, (int, float)) and not isinstance(d, bool):
-                x = _v.finite(v, f"{name('method_params')}[{k!r}]")
-                return float(x) if isinstance(d, float) else _plain(v)
-            return _plain(v)
-
-        resolved = {k: typed(k, resolved[k]) for k in sorted(resolved)}
-        try:
-            json.dumps(resolved, allow_nan=False)
-        except (TypeError, ValueError):
-            raise ValueError(
-                f"{name('method_params')} must hold JSON-serialisable values, got "
-                f"{self.method_params!r}"
-            ) from None
+        m, resolved = _resolved(self.method, self.method_params, "method")
         put("method_params", resolved)
+        nm, nresolved = _resolved(
+            self.no_gyro_method, self.no_gyro_method_params, "no_gyro_method"
+        )
+        if nm.uses_gyr:
+            raise ValueError(
+                f"{name('no_gyro_method')}: method {nm.name!r} needs a gyroscope; "
+                "choose one of "
+                f"{', '.join(_filters.methods(needs=('acc', 'mag')))}"
+            )
+        put("no_gyro_method_params", nresolved)
+        _dry_run(nm, nresolved, nm.requires_mag, "no_gyro_method_params")
         for f in ("use_mag", "calibration_gyro", "auto_threshold"):
             v = getattr(self, f)
             if not isinstance(v, (bool, np.bool_)):
@@ -181,7 +216,7 @@ class FeatureConfig:
             raise ValueError(
                 f"{name('use_mag')}: method {self.method!r} does not use a magnetometer"
             )
-        _dry_run(m, resolved, self.use_mag)
+        _dry_run(m, resolved, self.use_mag or m.requires_mag)
         choices = {
             "calibration_model": ("offsets", "ellipsoid"),
             "gyr_offset": ("auto", "none"),
@@ -207,6 +242,9 @@ class FeatureConfig:
             _v.integer(self.visited_min_count, name("visited_min_count"), minimum=1),
         )
         put("dba_window_s", _v.positive(self.dba_window_s, name("dba_window_s")))
+        for f in ("acc_threshold_g", "acc_window_s"):
+            put(f, _v.positive(getattr(self, f), name(f)))
+        put("acc_smooth_s", _v.nonnegative(self.acc_smooth_s, name("acc_smooth_s")))
         thr = self._floats("tilt_thresholds_deg")
         if any(not 0 < t < 180 for t in thr):
             raise ValueError(

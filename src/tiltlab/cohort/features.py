@@ -34,6 +34,15 @@ r"""Per-session head-tilt features (Fayat et al. 2021, §2.5–2.10, §3.3–3.4
    * the fraction of time with the head tilted beyond :math:`\theta`:
      :math:`\arccos(g_{s,z}) > \theta`.
 
+Sessions without a gyroscope (bio-logging tags: accelerometer, maybe magnetometer) are
+first-class: the tilt comes from ``config.no_gyro_method`` (the static-acceleration
+low-pass by default), immobility from the accelerometer rule
+(:func:`tiltlab.behavior.acc_immobility`, VeDBA below ``config.acc_threshold_g``), and
+the features that need the angular velocity (gyroscope offset, angular-speed quantiles,
+the valley threshold, circling) are NaN with the reason in the result's attrs. The
+same holds for a session with no immobile or no moving sample: the features over the
+empty set are NaN, with the reason, never an error.
+
 References
 ----------
 .. [1] R. Fayat et al., "Inertial Measurement of Head Tilt in Rodents: Principles and
@@ -57,7 +66,10 @@ from .. import units as _units
 from .._validate import RecordingError
 from .config import FeatureConfig
 
-__all__ = ["feature_specs", "session_features", "empty_features"]
+__all__ = ["feature_specs", "session_features", "empty_features", "session_tilt"]
+
+#: the reason given for the features that need the angular velocity
+NO_GYRO = "needs a gyroscope; the Recording has no 'gyr'"
 
 
 def _tag(x: float) -> str:
@@ -76,8 +88,9 @@ def feature_specs(config: FeatureConfig | None = None) -> dict[str, tuple[str, s
         "gyr_offset_z": ("deg/s", "gyroscope offset removed, z (session estimate)"),
         "immobile_fraction": (
             "1",
-            f"fraction of time immobile (angular speed < {thr}, gaps < "
-            f"{c.merge_gap_s:g} s merged, periods < {c.min_duration_s:g} s dropped)",
+            f"fraction of time immobile (angular speed < {thr}, or without a "
+            f"gyroscope VeDBA < {c.acc_threshold_g:g} g; gaps < {c.merge_gap_s:g} s "
+            f"merged, periods < {c.min_duration_s:g} s dropped)",
         ),
         "immobile_fraction_auto": (
             "1",
@@ -97,9 +110,9 @@ def feature_specs(config: FeatureConfig | None = None) -> dict[str, tuple[str, s
             "1",
             "fraction of the sphere's area visited by the tilt while moving",
         ),
-        "tilt_immobile_x": ("1", "vMF mean tilt during immobility, x (nose)"),
-        "tilt_immobile_y": ("1", "vMF mean tilt during immobility, y (left)"),
-        "tilt_immobile_z": ("1", "vMF mean tilt during immobility, z (up)"),
+        "tilt_immobile_x": ("1", "vMF mean tilt during immobility, sensor x axis"),
+        "tilt_immobile_y": ("1", "vMF mean tilt during immobility, sensor y axis"),
+        "tilt_immobile_z": ("1", "vMF mean tilt during immobility, sensor z axis"),
         "tilt_immobile_kappa": ("1", "vMF concentration of the tilt during immobility"),
         "tilt_immobile_sagittal_deg": (
             "deg",
@@ -133,18 +146,30 @@ def feature_specs(config: FeatureConfig | None = None) -> dict[str, tuple[str, s
     return spec
 
 
-def _dataset(values: dict[str, float], config: FeatureConfig, attrs=None) -> xr.Dataset:
+def _dataset(
+    values: dict[str, float],
+    config: FeatureConfig,
+    attrs=None,
+    reasons: dict[str, str] | None = None,
+) -> xr.Dataset:
     spec = feature_specs(config)
-    data = {
-        k: ((), np.float64(values.get(k, np.nan)), {"units": u, "long_name": ln})
-        for k, (u, ln) in spec.items()
-    }
+    reasons = dict(reasons or {})
+    data = {}
+    for k, (u, ln) in spec.items():
+        v = np.float64(values.get(k, np.nan))
+        a = {"units": u, "long_name": ln}
+        if np.isnan(v) and k in reasons:
+            a["reason"] = reasons[k]
+        data[k] = ((), v, a)
     a = {
         "feature_config": config.to_json(),
         "config_hash": config.hash(),
         "tiltlab_version": __version__,
         **dict(attrs or {}),
     }
+    if reasons:
+        a["reasons"] = reasons
+        a["notes"] = "; ".join(f"{k}: {r}" for k, r in reasons.items())
     return xr.Dataset(data, attrs=a)
 
 
@@ -182,7 +207,7 @@ def _corrected(rec: xr.Dataset, config: FeatureConfig, calibration):
         rec = _calibration.calibrate(rec, cal)
         stacked = "gyr_offset" in cal.corrects()
     off = np.zeros(3)
-    if config.gyr_offset == "auto":
+    if config.gyr_offset == "auto" and "gyr" in rec:
         raw = np.asarray(_calibration.robust_gyro_offset(rec), float)
         off = raw * _units.conversion_factor(rec["gyr"].attrs["units"], "deg/s")
         rec = _calibration.calibrate(
@@ -227,11 +252,20 @@ def session_tilt(
     return rec, _tilt(rec, config)
 
 
+def _tilt_method(rec: xr.Dataset, config: FeatureConfig) -> tuple[str, dict, bool]:
+    """The method, parameters and ``use_mag`` for this Recording: ``config.method``
+    when the Recording has what it needs, else ``config.no_gyro_method``."""
+    have = {v for v in _filters.SENSORS if v in rec}
+    if set(_filters.get_method(config.method).needs) <= have:
+        return config.method, config.method_params, config.use_mag
+    return config.no_gyro_method, config.no_gyro_method_params, False
+
+
 def _tilt(rec: xr.Dataset, config: FeatureConfig) -> xr.DataArray:
-    """Gravity-up direction of a corrected Recording with the configured method."""
-    q = _filters.estimate(
-        rec, config.method, use_mag=config.use_mag, **config.method_params
-    )
+    """Gravity-up direction of a corrected Recording with the configured method (or,
+    without the sensors it needs, ``config.no_gyro_method``)."""
+    method, params, use_mag = _tilt_method(rec, config)
+    q = _filters.estimate(rec, method, use_mag=use_mag, **params)
     return _filters.gravity(q)
 
 
@@ -252,6 +286,7 @@ def session_features(
     config: FeatureConfig | None = None,
     *,
     calibration=None,
+    check_units: bool = True,
 ) -> xr.Dataset:
     r"""Head-tilt features of one session, as a Dataset of labelled scalars.
 
@@ -265,15 +300,33 @@ def session_features(
         The subject's tumble-test Recording (its accelerometer offsets, or ellipsoid,
         are fitted with :func:`tiltlab.calibration.tumble_calibration` and applied),
         or a ready :class:`~tiltlab.calibration.Calibration`.
+    check_units : bool
+        Check the values against their unit labels when re-validating the Recording
+        (:func:`tiltlab.schema.validate`); ``False`` accepts the labels as they are.
 
     Returns
     -------
     xarray.Dataset
         0-d variables named by :func:`feature_specs`, each with ``units`` and a
         one-line ``long_name``; attrs ``feature_config`` (the configuration's JSON),
-        ``config_hash``, ``tiltlab_version``, ``source``. A feature that is undefined
-        for this session (no immobility, no movement, a unimodal speed distribution)
-        is NaN and the reason is listed in ``attrs["notes"]``.
+        ``config_hash``, ``tiltlab_version``, ``source``, ``sensors`` (the Recording's
+        sensor variables), ``tilt_method`` (the orientation method used) and
+        ``immobility_rule`` (gyroscope or accelerometer, with its threshold and
+        units). A feature that is undefined for this session (no gyroscope, no
+        immobility, no movement, a unimodal speed distribution) is NaN, with the
+        reason in its own ``reason`` attribute, in ``attrs["reasons"]`` (feature →
+        reason) and in ``attrs["notes"]`` (one line).
+
+    Examples
+    --------
+    >>> from tiltlab import cohort
+    >>> from tiltlab.simulate import simulate_session
+    >>> rec = simulate_session(20.0, 100.0, seed=1, keep_true=False).drop_vars("gyr")
+    >>> f = cohort.session_features(rec, cohort.FeatureConfig(mesh_n=500))
+    >>> f.attrs["tilt_method"], f.attrs["immobility_rule"].split(":")[0]
+    ('lowpass', 'accelerometer')
+    >>> bool(f["circling_index"].isnull()), f["circling_index"].attrs["reason"]
+    (True, "needs a gyroscope; the Recording has no 'gyr'")
 
     Raises
     ------
@@ -304,9 +357,15 @@ def session_features(
     config = config or FeatureConfig()
     if not isinstance(config, FeatureConfig):
         raise TypeError(f"config must be a FeatureConfig, got {type(config).__name__}")
-    _schema.validate(recording, allow_nan=True)
+    if not isinstance(recording, xr.Dataset):
+        raise TypeError(
+            "recording must be a Recording (xarray.Dataset), got "
+            f"{type(recording).__name__}"
+        )
+    _schema.validate(recording, allow_nan=True, check_units=check_units)
+    has_gyr = "gyr" in recording
     for v in ("acc", "gyr"):
-        if not np.isfinite(recording[v].values).all():
+        if v in recording and not np.isfinite(recording[v].values).all():
             raise RecordingError(f"the Recording's {v!r} has non-finite samples")
     rec, off = _corrected(recording, config, calibration)
     fs = float(rec.attrs["fs"])
@@ -316,22 +375,56 @@ def session_features(
             f"the recording is too short for the features ({n} samples, {n / fs:.2f} s;"
             " at least 2 s needed)"
         )
-    notes: list[str] = []
-    out: dict[str, float] = {"n_samples": n, "duration_s": n / fs}
-    out.update({f"gyr_offset_{a}": float(o) for a, o in zip("xyz", off)})
+    spec = feature_specs(config)
+    reasons: dict[str, str] = {}
 
+    def undefined(keys, reason: str) -> None:
+        for k in keys:
+            reasons.setdefault(k, reason)
+
+    out: dict[str, float] = {"n_samples": n, "duration_s": n / fs}
+    offset_keys = [f"gyr_offset_{a}" for a in "xyz"]
+    speed_keys = [k for k in spec if k.startswith("angular_speed_moving_q")]
+    if has_gyr:
+        out.update({k: float(o) for k, o in zip(offset_keys, off)})
+    else:
+        undefined(offset_keys, NO_GYRO)
+
+    method, _, _ = _tilt_method(rec, config)
     g = _tilt(rec, config)
     gv = g.values
-    speed = _behavior.angular_speed(rec)
-    sp = np.asarray(speed, float)
-    imm = _immobile(speed, config, config.threshold_deg_s)
+    if has_gyr:
+        speed = _behavior.angular_speed(rec)
+        sp = np.asarray(speed, float)
+        imm = _immobile(speed, config, config.threshold_deg_s)
+        rule = (
+            f"gyroscope: angular speed < {config.threshold_deg_s:g} deg/s, gaps < "
+            f"{config.merge_gap_s:g} s merged, periods < {config.min_duration_s:g} s "
+            "dropped"
+        )
+    else:
+        still = _behavior.acc_immobility(
+            rec,
+            threshold_g=config.acc_threshold_g,
+            window_s=config.acc_window_s,
+            smooth_s=config.acc_smooth_s,
+            merge_gap_s=config.merge_gap_s,
+            min_duration_s=config.min_duration_s,
+        )
+        imm = np.asarray(still, dtype=bool)
+        rule = f"accelerometer: {still.attrs['rule_description']}"
     moving = ~imm
     out["immobile_fraction"] = float(imm.mean())
-    if config.auto_threshold:
+    auto_keys = ["immobility_threshold_auto", "immobile_fraction_auto"]
+    if not config.auto_threshold:
+        undefined(auto_keys, "not computed (config.auto_threshold is False)")
+    elif not has_gyr:
+        undefined(auto_keys, NO_GYRO + " (valley of the angular-speed histogram)")
+    else:
         try:
             thr = _behavior.valley_threshold(speed)
         except ValueError as exc:
-            notes.append(f"immobility_threshold_auto: {exc}")
+            undefined(auto_keys, str(exc))
         else:
             out["immobility_threshold_auto"] = float(thr)
             out["immobile_fraction_auto"] = float(_immobile(speed, config, thr).mean())
@@ -339,13 +432,15 @@ def session_features(
     mesh = _sphere.sphere_mesh(config.mesh_n)
     for key, mask in (("visited_fraction", None), ("visited_fraction_moving", moving)):
         if mask is not None and not mask.any():
-            notes.append(f"{key}: no moving samples")
+            undefined([key], "no moving samples")
             continue
         tmap = _sphere.tilt_map(g, mesh=mesh, mask=mask)
         out[key] = _sphere.visited_fraction(
             tmap, mesh, min_count=config.visited_min_count, by="area"
         )
 
+    tilt_keys = [f"tilt_immobile_{a}" for a in "xyz"]
+    tilt_keys += ["tilt_immobile_kappa", "tilt_immobile_sagittal_deg"]
     if imm.sum() >= 2:
         fit = _sphere.vmf_fit(gv[imm])
         out.update({f"tilt_immobile_{a}": float(m) for a, m in zip("xyz", fit.mu)})
@@ -354,15 +449,17 @@ def session_features(
             np.degrees(_sphere.sagittal_angle(fit.mu, config.lesion_side))
         )
     else:
-        notes.append("tilt_immobile_*: fewer than 2 immobile samples")
+        undefined(tilt_keys, f"fewer than 2 immobile samples ({int(imm.sum())})")
 
-    if moving.any():
+    if not has_gyr:
+        undefined(["circling_index", *speed_keys], NO_GYRO)
+    elif moving.any():
         out["circling_index"] = _behavior.circling_index(rec, g, moving=moving)
         for q in config.speed_quantiles:
             key = f"angular_speed_moving_q{_tag(100 * q)}"
             out[key] = float(np.quantile(sp[moving], q))
     else:
-        notes.append("circling_index, angular_speed_moving_*: no moving samples")
+        undefined(["circling_index", *speed_keys], "no moving samples")
 
     to_g = _units.conversion_factor(rec["acc"].attrs["units"], "g")
     out["dba_mean"] = float(
@@ -376,7 +473,10 @@ def session_features(
     for t in config.tilt_thresholds_deg:
         out[f"tilted_fraction_{_tag(t)}deg"] = float(np.mean(tilt_deg > t))
 
-    attrs = {"source": str(recording.attrs.get("source", ""))}
-    if notes:
-        attrs["notes"] = "; ".join(notes)
-    return _dataset(out, config, attrs)
+    attrs = {
+        "source": str(recording.attrs.get("source", "")),
+        "sensors": ", ".join(v for v in _filters.SENSORS if v in recording),
+        "tilt_method": method,
+        "immobility_rule": rule,
+    }
+    return _dataset(out, config, attrs, reasons)

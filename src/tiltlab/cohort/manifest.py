@@ -9,10 +9,13 @@ One row per session, with the columns
 ``timepoint``      time relative to the intervention (e.g. ``7d`` or a number of days;
                    may be empty for cross-sectional data)
 ``file``           the session's recording, relative to the manifest's folder or absolute
-``reader``         ``netcdf``, ``fayat_csv``, ``fayat_tumble``, ``broad`` or ``csv``
+``reader``         ``netcdf``, ``fayat_csv``, ``fayat_tumble``, ``broad``, ``csv``,
+                   ``tagtools`` (tag-tools NetCDF) or ``auto`` (:func:`tiltlab.io.read`
+                   chooses from the file's content)
 ``reader_options`` optional: a JSON object of keyword arguments for the reader, e.g. the
                    generic CSV's ``{"columns": {...}, "units": {...}, "fs": 100}``;
-                   empty for most readers
+                   empty for most readers. ``{"check_units": false}`` accepts the unit
+                   labels as they are, for the session's file and its calibration
 ``calibration``    optional: the subject's tumble-test recording (``.nc`` read with
                    :func:`tiltlab.io.load_netcdf`, ``.csv`` with
                    :func:`tiltlab.io.read_fayat_tumble`)
@@ -46,6 +49,7 @@ import pandas as pd
 import xarray as xr
 
 from .. import io as _io
+from ..quality import UnitCheckError
 
 __all__ = [
     "REQUIRED_COLUMNS",
@@ -94,6 +98,8 @@ READERS: dict[str, Callable[..., xr.Dataset]] = {
     "fayat_tumble": _io.read_fayat_tumble,
     "broad": _io.read_broad,
     "csv": _io.read_csv,
+    "tagtools": _io.read_tagtools,
+    "auto": _io.read,
 }
 #: calibration file suffix → reader
 _CALIBRATION_READERS = {".nc": "netcdf", ".netcdf": "netcdf", ".csv": "fayat_tumble"}
@@ -320,6 +326,18 @@ def session_path(file, root) -> Path:
     return p if p.is_absolute() else Path(root) / p
 
 
+def _takes(func: Callable[..., Any], name: str) -> bool:
+    """True if ``func`` accepts the keyword ``name`` (explicitly or through ``**``)."""
+    try:
+        params = inspect.signature(func).parameters
+    except (TypeError, ValueError):
+        return False
+    if name in params:
+        return True
+    # **attrs of a reader are dataset attributes, not options: only io.read forwards
+    return func is _io.read
+
+
 def load_session(row: Mapping[str, Any], root) -> xr.Dataset:
     """Read one session's Recording with the reader its manifest row names.
 
@@ -351,7 +369,16 @@ def load_session(row: Mapping[str, Any], root) -> xr.Dataset:
     opts = row.get("reader_options", "")
     if not isinstance(opts, Mapping):
         opts = _options(opts, reader, f"session {row.get('session')!r}")
-    rec = READERS[reader](session_path(row["file"], root), **dict(opts))
+    opts = dict(opts)
+    func = READERS[reader]
+    if "check_units" in opts and not _takes(func, "check_units"):
+        # readers of published data sets label their units themselves
+        opts.pop("check_units")
+    try:
+        rec = func(session_path(row["file"], root), **opts)
+    except UnitCheckError as err:
+        # name the switch as a manifest gives it
+        raise err.for_switch("manifest") from None
     extra = {
         f"cohort_{k}": str(row[k]) for k in ("session", "subject", "group") if k in row
     }
@@ -370,7 +397,20 @@ def load_calibration(row: Mapping[str, Any], root) -> xr.Dataset | None:
     reader = _CALIBRATION_READERS.get(Path(cal).suffix.lower())
     if reader is None:
         raise ManifestError(f"calibration file {cal!r} must be .nc or .csv")
-    return READERS[reader](session_path(cal, root))
+    opts = row.get("reader_options", "")
+    if not isinstance(opts, Mapping):
+        try:
+            opts = json.loads(str(opts)) if str(opts or "").strip() else {}
+        except json.JSONDecodeError:
+            opts = {}
+    kw = {}
+    if isinstance(opts, Mapping) and opts.get("check_units") is False:
+        if _takes(READERS[reader], "check_units"):
+            kw["check_units"] = False
+    try:
+        return READERS[reader](session_path(cal, root), **kw)
+    except UnitCheckError as err:
+        raise err.for_switch("manifest") from None
 
 
 # ------------------------------------------------------------------ init_manifest

@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import functools
 import hashlib
+import inspect
 import json
 import os
 import sys
@@ -34,6 +35,7 @@ import xarray as xr
 
 from .. import __version__
 from .. import io as _io
+from ..quality import UnitCheckError
 from .config import FeatureConfig
 from .features import feature_specs, session_features
 from .manifest import (
@@ -59,14 +61,31 @@ __all__ = [
 CACHE_VERSION = 1
 DEFAULT_CACHE = ".tiltlab-cache"
 
+#: keywords :func:`session_features` takes (``check_units`` once it re-validates with it)
+_FEATURE_PARAMS = frozenset(inspect.signature(session_features).parameters)
+
 
 # ------------------------------------------------------------------ one session
 
 
 @functools.lru_cache(maxsize=8)
-def _calibration_file(path: str, size: int, mtime_ns: int) -> xr.Dataset | None:
+def _calibration_file(
+    path: str, size: int, mtime_ns: int, check_units: bool = True
+) -> xr.Dataset | None:
     # a subject's tumble test serves all its sessions: read it once per process
-    return load_calibration({"calibration": path}, "/")
+    opts = {} if check_units else {"check_units": False}
+    return load_calibration({"calibration": path, "reader_options": opts}, "/")
+
+
+def _check_units(row: dict) -> bool:
+    """False when the row's reader_options say ``"check_units": false``."""
+    opts = row.get("reader_options", "")
+    if not isinstance(opts, dict):
+        try:
+            opts = json.loads(str(opts)) if str(opts or "").strip() else {}
+        except json.JSONDecodeError:
+            return True
+    return not (isinstance(opts, dict) and opts.get("check_units") is False)
 
 
 def _calibration_of(row: dict, root: str) -> xr.Dataset | None:
@@ -77,7 +96,9 @@ def _calibration_of(row: dict, root: str) -> xr.Dataset | None:
     if not path.is_file():
         return load_calibration(row, root)  # raises the reader's error
     st = path.stat()
-    return _calibration_file(str(path.resolve()), st.st_size, st.st_mtime_ns)
+    return _calibration_file(
+        str(path.resolve()), st.st_size, st.st_mtime_ns, _check_units(row)
+    )
 
 
 def compute_session(row: dict, root: str, config: FeatureConfig) -> dict[str, Any]:
@@ -90,8 +111,13 @@ def compute_session(row: dict, root: str, config: FeatureConfig) -> dict[str, An
     try:
         rec = load_session(row, root)
         cal = _calibration_of(row, root)
-        ds = session_features(rec, config, calibration=cal)
+        kw = {}
+        if not _check_units(row) and "check_units" in _FEATURE_PARAMS:
+            kw["check_units"] = False  # the feature step's re-validation, too
+        ds = session_features(rec, config, calibration=cal, **kw)
     except Exception as exc:  # any failure is recorded, never propagated
+        if isinstance(exc, UnitCheckError):
+            exc = exc.for_switch("manifest")
         msg = " ".join(str(exc).split())
         return {
             "session": row["session"],

@@ -16,7 +16,10 @@ Methods
 -------
 ``lowpass``
     Tilt from the normalised, zero-phase low-passed accelerometer (2nd-order
-    Butterworth, forward–backward; scipy). 6D only, heading zero.
+    Butterworth, forward–backward; scipy). Heading zero; needs no gyroscope.
+``davenport``
+    Accelerometer + magnetometer, no gyroscope: Davenport's q-method on every sample
+    (optionally low-passed first), ENU world frame [6]_.
 ``complementary``
     Gyroscope integration corrected towards the accelerometer (and magnetometer)
     by geometric rotations in the world frame, with time constants.
@@ -50,6 +53,15 @@ Methods
 ``ahrs_madgwick``, ``ahrs_mahony``, ``ahrs_ekf``
     Adapters to the pure-Python ``ahrs`` package (6D; slow: use short recordings), for
     comparison; the EKF runs with ``frame='NED'`` (really z up, see below).
+
+Recordings without a gyroscope
+------------------------------
+Most bio-logging tags record acceleration (and a magnetic field) only. Every method
+declares the variables it needs (:attr:`Method.needs`); ``methods(needs="acc")``,
+``methods(needs=("acc", "mag"))`` or ``methods(needs=recording)`` list the ones that
+run on such data, and :func:`estimate` refuses any other with a
+:class:`~tiltlab._validate.RecordingError` naming the method, the missing sensor and
+the methods that would run.
 
 Package layout
 --------------
@@ -153,7 +165,17 @@ from .lowpass import lowpass_tilt
 from .madgwick import madgwick, madgwick_batch
 from .mahony import mahony
 from .recordings import Inputs, estimate, gravity, prepare, run
-from .registry import METHODS, PARAMETER_UNITS, Method, defaults, get_method, methods
+from .registry import (
+    METHODS,
+    PARAMETER_UNITS,
+    SENSORS,
+    Method,
+    defaults,
+    get_method,
+    methods,
+    missing_sensor_message,
+    vector_observation,
+)
 from .rts import rts_smoother
 from .smoothers import rest_gyro_bias, smoother
 from .vectors import davenport, magnetic_dip
@@ -161,8 +183,11 @@ from .vectors import davenport, magnetic_dip
 __all__ = [
     "METHODS",
     "PARAMETER_UNITS",
+    "SENSORS",
     "Method",
     "methods",
+    "missing_sensor_message",
+    "vector_observation",
     "get_method",
     "defaults",
     "estimate",

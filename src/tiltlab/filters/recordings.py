@@ -177,14 +177,19 @@ def estimate(
     Parameters
     ----------
     recording : xarray.Dataset
-        A tiltlab Recording (``acc``, ``gyr``, optional ``mag``; attrs ``fs``).
+        A tiltlab Recording (``acc``; ``gyr`` and ``mag`` optional; attrs ``fs``).
+        Without ``gyr`` only the methods that need no gyroscope run
+        (``filters.methods(needs=recording)``: ``lowpass``, and ``davenport`` with a
+        magnetometer); any other is refused by name.
     method : str
         A name of :data:`tiltlab.filters.METHODS` (:func:`tiltlab.filters.methods`).
     use_mag : bool
-        Use the magnetometer (9D, ENU world frame).
+        Use the magnetometer (9D, ENU world frame). Implied for a method that requires
+        one (``davenport``).
     gaps : {"raise", "segments"}
         What to do with gaps: time steps longer than 1.5/``fs`` (dropped samples) and
-        samples where ``acc``, ``gyr`` (or ``mag``, with ``use_mag``) are not finite
+        samples where ``acc``, ``gyr`` (when the method uses it) or ``mag`` (with
+        ``use_mag``) are not finite
         (:func:`tiltlab._validate.segments`). ``"raise"`` (default): a
         :class:`~tiltlab._validate.RecordingError` saying where they are — a filter
         integrating the gyroscope across a gap would be silently wrong. ``"segments"``:
@@ -203,8 +208,9 @@ def estimate(
     -------
     xarray.DataArray, dims (time, quat)
         ``q``: unit quaternions sensor → world, with the Recording's ``time``
-        coordinate and attrs ``fs``, ``method``, ``use_mag``, ``world_frame`` and every
-        parameter as ``param_<name>``. With ``gaps="segments"`` also ``gaps``,
+        coordinate and attrs ``fs``, ``method``, ``use_mag``, ``world_frame``, every
+        parameter as ``param_<name>`` and the Recording's ``axis_labels`` (when it
+        has them). With ``gaps="segments"`` also ``gaps``,
         ``min_segment_s``, ``n_segments`` (segments estimated) and ``segments``: the
         times (s) of the first and last sample of each estimated segment, flattened
         ``[start_0, last_0, start_1, last_1, ...]``.
@@ -212,11 +218,25 @@ def estimate(
     Raises
     ------
     tiltlab._validate.RecordingError
-        With ``gaps="raise"``, a recording with gaps (and, whatever ``gaps``, the
-        problems :func:`prepare` reports).
+        A method that needs a variable the Recording lacks (a gyroscope, a
+        magnetometer): the message names the method and lists those that run. With
+        ``gaps="raise"``, a recording with gaps (and, whatever ``gaps``, the problems
+        :func:`prepare` reports).
     ValueError
         An unknown method, parameter or ``gaps`` value, or a negative
         ``min_segment_s``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from tiltlab import filters, schema
+    >>> acc = np.tile([0.0, 0.0, 1.0], (200, 1))
+    >>> rec = schema.make_recording(acc, fs=50.0, acc_units="g")  # no gyroscope
+    >>> filters.methods(needs=rec)
+    ('lowpass',)
+    >>> q = filters.estimate(rec, "lowpass")
+    >>> q.dims, q.attrs["method"]
+    (('time', 'quat'), 'lowpass')
     """
     m = get_method(method)
     if use_mag and not m.supports_mag:
@@ -224,15 +244,23 @@ def estimate(
             f"method {method!r} does not use a magnetometer; "
             "use_mag=True is not supported"
         )
+    use_mag = bool(use_mag or m.requires_mag)
     if not isinstance(gaps, str) or gaps not in GAP_POLICIES:
         raise ValueError(f"gaps must be one of {GAP_POLICIES}, got {gaps!r}")
     min_segment_s = _v.nonnegative(min_segment_s, "min_segment_s")
     full = m.resolve(params)
+    if isinstance(recording, xr.Dataset):
+        have = [v for v in registry.SENSORS if v in recording]
+        for name in m.needs:
+            if name not in have:
+                raise _v.RecordingError(registry.missing_sensor_message(m, name, have))
     inputs = prepare(recording, use_mag=use_mag, allow_nan=True)
     n = inputs.acc.shape[0]
     time = _time_axis(inputs)
-    stacked = [inputs.acc, inputs.gyr] + ([inputs.mag] if use_mag else [])
+    used = ["acc"] + (["gyr"] if m.uses_gyr else []) + (["mag"] if use_mag else [])
+    stacked = [getattr(inputs, v) for v in used]
     segs = _v.segments(time, inputs.fs, values=np.concatenate(stacked, axis=1))
+    labels = recording.attrs.get("axis_labels")
     attrs: dict[str, Any] = {
         "method": method,
         "use_mag": int(bool(use_mag)),
@@ -240,9 +268,10 @@ def estimate(
         "frame": "sensor->world",
         "world_frame": "ENU" if use_mag else "z up, heading arbitrary",
         **{f"param_{k}": attr_value(v) for k, v in full.items()},
+        **({"axis_labels": list(labels)} if labels is not None else {}),
     }
     if gaps == "raise" and n and segs != [(0, n)]:
-        names = "acc, gyr" + (", mag" if use_mag else "")
+        names = ", ".join(used)
         raise _v.RecordingError(
             f"the Recording has gaps (time steps longer than 1.5/fs = "
             f"{1.5 / inputs.fs:.3g} s, or non-finite {names} samples): "
@@ -260,7 +289,8 @@ def estimate(
             if (b - a) / inputs.fs < min_segment_s:
                 continue
             mag = None if inputs.mag is None else inputs.mag[a:b]
-            q[a:b] = m(inputs.acc[a:b], inputs.gyr[a:b], inputs.fs, mag, **full)
+            gyr = None if inputs.gyr is None else inputs.gyr[a:b]
+            q[a:b] = m(inputs.acc[a:b], gyr, inputs.fs, mag, **full)
             kept.append((a, b))
         left = int(np.isnan(q[:, 0]).sum())
         if left:

@@ -435,7 +435,7 @@ def missing_sensor_message(
     have = set(have) - {missing}
     ok = methods(needs=sorted(have)) if have else ()
     alt = ", ".join(repr(n) for n in ok) or "none"
-    if "mag" not in have:
+    if "mag" not in have and missing != "mag":
         more = [n for n in methods(needs=sorted(have | {"mag"})) if n not in ok]
         if more:
             alt += "; with a magnetometer also " + ", ".join(repr(n) for n in more)

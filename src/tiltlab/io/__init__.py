@@ -1,18 +1,25 @@
 """Readers and writers. I/O only: each reader parses a file into a Recording
-(:mod:`tiltlab.schema`) without any processing beyond unit labelling, and each
-writer stores one losslessly.
+(:mod:`tiltlab.schema`) without any processing beyond unit labelling and axis mapping,
+and each writer stores one losslessly.
 
 Supported formats
 -----------------
+* Any file below through one entry point, :func:`read` (the reader chosen from the
+  file's content), and :func:`detect`, one line saying what a file looks like.
 * Fayat et al. 2021 CSV files: the freely-moving example (``read_fayat_imu``) and
   the tumble test (``read_fayat_tumble``).
 * BROAD benchmark trials, ``.hdf5`` and MATLAB ``.mat`` layouts (``read_broad``).
 * A generic CSV with a column/unit mapping (``read_csv``), the mapping given as a dict
-  or a JSON file (``read_csv_mapping``); time columns in s, ms or µs.
+  or a JSON file (``read_csv_mapping``); time columns in s, ms, µs, ns or date-times,
+  on a regular grid or resampled from a jittery clock (``clock="resample"``).
+* Exports with one file per sensor, each on its own clock (``read_multi``).
+* Mappings for public recordings from other labs (``mapping_template``).
+* tag-tools (animaltags) NetCDF archives, NetCDF-4 or NetCDF-3 (``read_tagtools``).
 * One numeric variable of a MATLAB file, v4–v7 or v7.3/HDF5 (``read_matrix``), in
   MATLAB's own shape.
 * NetCDF via h5netcdf (``save_netcdf`` / ``load_netcdf``), exact round trip
-  including attributes of any JSON-serialisable type.
+  including attributes of any JSON-serialisable type; ``open_netcdf`` opens any
+  NetCDF-4 or NetCDF-3 file as stored.
 """
 
 from __future__ import annotations
@@ -20,21 +27,39 @@ from __future__ import annotations
 from ._common import ReadError
 from .broad import read_broad
 from .csv import FS_RANGE, GAP_POLICIES, TIME_UNITS, read_csv, read_csv_mapping
+from .detect import detect, read
 from .fayat import read_fayat_imu, read_fayat_tumble
+from .mapping import mapping_template
 from .mat import read_matrix
-from .netcdf import load_netcdf, save_netcdf
+from .multi import read_multi
+from .netcdf import (
+    NotRecordingError,
+    load_netcdf,
+    netcdf_format,
+    open_netcdf,
+    save_netcdf,
+)
+from .tagtools import read_tagtools
 
 __all__ = [
     "ReadError",
+    "NotRecordingError",
+    "read",
+    "detect",
     "read_fayat_imu",
     "read_fayat_tumble",
     "read_broad",
     "read_csv",
     "read_csv_mapping",
+    "read_tagtools",
+    "read_matrix",
+    "read_multi",
+    "mapping_template",
     "TIME_UNITS",
     "FS_RANGE",
     "GAP_POLICIES",
     "save_netcdf",
     "load_netcdf",
-    "read_matrix",
+    "open_netcdf",
+    "netcdf_format",
 ]

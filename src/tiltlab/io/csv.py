@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 import os
 from collections.abc import Mapping, Sequence
 from pathlib import Path
@@ -14,286 +13,20 @@ import xarray as xr
 
 from .. import _validate, schema
 from .. import quality as _quality
-from .. import units as _units
-from ._common import PathLike, ReadError, _read_table
+from . import clock as _clock
+from ._common import PathLike, ReadError, _missing_columns_message
+from .clock import CLOCK_POLICIES, GAP_POLICIES, MAX_GAP, TIME_UNITS
+from .mapping import FS_RANGE, check_mapping, load_mapping
 
-
-#: Units accepted for a CSV time column, as factors to seconds.
-TIME_UNITS: dict[str, float] = {"s": 1.0, "ms": 1e-3, "us": 1e-6}
-_TIME_ALIASES = {"s": "s", "sec": "s", "ms": "ms", "us": "us", "µs": "us", "μs": "us"}
-
-#: Sampling rates (Hz) accepted by :func:`read_csv` unless told otherwise: a value
-#: outside this range almost always means a time column in the wrong unit.
-FS_RANGE: tuple[float, float] = (1.0, 20_000.0)
-
-#: What :func:`read_csv` does with samples missing from the time column (dropped by a
-#: logger): refuse the file, or put NaN rows in their place.
-GAP_POLICIES: tuple[str, ...] = ("raise", "nan")
-
-#: Number of columns each Recording variable takes from a CSV.
-_WIDTH = {"acc": 3, "gyr": 3, "mag": 3, "temp": 1, "q_ref": 4}
-_MAPPING_KEYS = (
-    "columns",
-    "units",
-    "fs",
-    "time_column",
-    "time_scale",
-    "time_units",
-    "fs_range",
-    "range",
-    "scale",
-    "gaps",
-    "attrs",
+__all__ = [
     "read_csv",
-)
-_NOT_READ_KWARGS = {"filepath_or_buffer", "usecols", "dtype"}
-
-
-def _read_csv_params() -> frozenset[str]:
-    import inspect
-
-    return frozenset(inspect.signature(pd.read_csv).parameters) - _NOT_READ_KWARGS
-
-
-def _time_factor(time_units: str, where: str) -> float:
-    key = _TIME_ALIASES.get(str(time_units).strip())
-    if key is None:
-        raise ValueError(
-            f"{where}time_units must be one of 's', 'ms', 'us', got {time_units!r}"
-        )
-    return TIME_UNITS[key]
-
-
-_RAW_UNITS = {"counts", "count", "lsb", "raw", "adc", "digits", "bits"}
-
-
-def _scaled_unit_hint(var: str, unit: object) -> str:
-    """A hint for a unit that is a known one with a prefix (``mg``, ``mdps``) or raw
-    ADC counts: read the column with a ``scale`` factor instead."""
-    if not isinstance(unit, str):
-        return ""
-    key = unit.strip()
-    if key.lower() in _RAW_UNITS:
-        example = {"acc": ("g", "1/16384 (±2 g)"), "gyr": ("deg/s", "1/131 (±250 °/s)")}
-        u, f = example.get(var, ("its physical unit", "1/sensitivity"))
-        return (
-            f"; for raw ADC counts give the physical unit and a factor, e.g. "
-            f"units {{{var!r}: {u!r}}} and scale {{{var!r}: {f}}}"
-        )
-    for prefix, factor in (("m", "0.001"), ("milli", "0.001"), ("milli-", "0.001")):
-        rest = key[len(prefix) :]
-        if key.startswith(prefix) and rest:
-            try:
-                canon = _units.normalise_unit(rest)
-            except _units.UnitsError:
-                continue
-            return (
-                f"; {unit!r} looks like milli-{canon}: give units {{{var!r}: {canon!r}}} "
-                f"and scale {{{var!r}: {factor}}}"
-            )
-    return ""
-
-
-def _load_mapping(mapping: Mapping[str, Any] | PathLike) -> tuple[dict[str, Any], str]:
-    """The raw mapping as a dict, and a prefix naming it in messages."""
-    if isinstance(mapping, Mapping):
-        return dict(mapping), "mapping: "
-    if not isinstance(mapping, (str, os.PathLike)):
-        raise TypeError(
-            f"mapping must be a dict or the path of a JSON file, got {type(mapping).__name__}"
-        )
-    path = Path(mapping)
-    if not path.is_file():
-        raise ReadError(f"{path}: no such mapping file")
-    try:
-        raw = json.loads(path.read_text(encoding="utf-8"))
-    except UnicodeDecodeError as exc:
-        raise ReadError(f"{path}: not a text (JSON) file ({exc.reason})") from None
-    except json.JSONDecodeError as exc:
-        raise ValueError(
-            f"{path}: not valid JSON (line {exc.lineno}, column {exc.colno}: {exc.msg})"
-        ) from None
-    if not isinstance(raw, dict):
-        raise ValueError(
-            f"{path}: a mapping is a JSON object with keys 'columns' and 'units', "
-            f"got a JSON {type(raw).__name__}"
-        )
-    return raw, f"mapping {path}: "
-
-
-def _check_mapping(raw: Mapping[str, Any], where: str) -> dict[str, Any]:
-    """Check a raw mapping and return it normalised (see :func:`read_csv_mapping`)."""
-    allowed_read = _read_csv_params()
-    unknown = [k for k in raw if k not in _MAPPING_KEYS and k not in allowed_read]
-    if unknown:
-        raise ValueError(
-            f"{where}unknown key(s) {unknown}; a mapping has {', '.join(_MAPPING_KEYS)} "
-            "and pandas.read_csv options (sep, decimal, skiprows, comment, encoding, ...)"
-        )
-    columns = raw.get("columns")
-    if not isinstance(columns, Mapping) or not columns:
-        raise ValueError(
-            f"{where}'columns' must map variables to column names, e.g. "
-            '{"acc": ["ax", "ay", "az"], "gyr": ["gx", "gy", "gz"]}'
-        )
-    cols: dict[str, list[str]] = {}
-    for var, names in columns.items():
-        if var not in _WIDTH:
-            raise ValueError(
-                f"{where}unknown variable {var!r} in 'columns' (known: {', '.join(_WIDTH)})"
-            )
-        names = [names] if isinstance(names, str) else names
-        if not isinstance(names, Sequence) or not all(
-            isinstance(c, str) for c in names
-        ):
-            raise ValueError(
-                f"{where}columns[{var!r}] must be a column name or a list of names, got {names!r}"
-            )
-        if len(names) != _WIDTH[var]:
-            raise ValueError(
-                f"{where}columns[{var!r}] needs {_WIDTH[var]} column(s), got {len(names)}: {list(names)}"
-            )
-        cols[var] = list(names)
-    for var in ("acc", "gyr"):
-        if var not in cols:
-            raise ValueError(f"{where}'columns' must map {var!r}")
-    units_in = raw.get("units") or {}
-    if not isinstance(units_in, Mapping):
-        raise ValueError(f"{where}'units' must map variables to unit strings")
-    units: dict[str, str] = {}
-    for var, unit in units_in.items():
-        if var == "time":
-            continue
-        if var not in _WIDTH:
-            raise ValueError(
-                f"{where}unknown variable {var!r} in 'units' (known: {', '.join(_WIDTH)}, time)"
-            )
-        try:
-            units[var] = _units.normalise_unit(unit)
-        except _units.UnitsError as exc:
-            raise ValueError(
-                f"{where}units[{var!r}]: {exc}{_scaled_unit_hint(var, unit)}"
-            ) from None
-    for var in cols:
-        if var != "q_ref" and var not in units:
-            raise ValueError(
-                f"{where}units must give the unit of {var!r}; tiltlab does not assume one"
-            )
-    # time: a column, and its unit as time_units ("s", "ms", "us"), units["time"] or time_scale
-    time_column = raw.get("time_column")
-    if time_column is not None and not isinstance(time_column, str):
-        raise ValueError(
-            f"{where}time_column must be a column name, got {time_column!r}"
-        )
-    unit_sources = {
-        k: v
-        for k, v in (
-            ("time_units", raw.get("time_units")),
-            ("units['time']", units_in.get("time")),
-        )
-        if v is not None
-    }
-    factors = {k: _time_factor(v, where) for k, v in unit_sources.items()}
-    if raw.get("time_scale") is not None:
-        factors["time_scale"] = _validate.positive(
-            raw["time_scale"], f"{where}time_scale"
-        )
-    if len(set(factors.values())) > 1:
-        raise ValueError(
-            f"{where}the time unit is given twice and disagrees: {factors} (factors to seconds)"
-        )
-    if factors and time_column is None:
-        raise ValueError(f"{where}a time unit is given but no time_column")
-    time_scale = next(iter(factors.values()), 1.0)
-    fs = raw.get("fs")
-    if fs is not None:
-        fs = _validate.check_fs(fs, f"{where}fs")
-    elif time_column is None:
-        raise ValueError(
-            f"{where}give fs, or a time_column from which to estimate it; "
-            "tiltlab never assumes a sampling rate"
-        )
-    fs_range = raw.get("fs_range", FS_RANGE)
-    if fs_range is not None:
-        if not isinstance(fs_range, Sequence) or len(fs_range) != 2:
-            raise ValueError(
-                f"{where}fs_range must be [low, high] in Hz, got {fs_range!r}"
-            )
-        lo = _validate.positive(fs_range[0], f"{where}fs_range[0]")
-        hi = _validate.positive(fs_range[1], f"{where}fs_range[1]", allow_inf=True)
-        if lo >= hi:
-            raise ValueError(f"{where}fs_range must be [low, high], got {fs_range!r}")
-        fs_range = (lo, hi)
-    full: dict[str, Any] = {}
-    range_in = raw.get("range") or {}
-    if not isinstance(range_in, Mapping):
-        raise ValueError(
-            f"{where}'range' must map variables to their full scale, e.g. "
-            '{"acc": 16, "gyr": 2000}'
-        )
-    for var, value in range_in.items():
-        if var not in ("acc", "gyr", "mag"):
-            raise ValueError(
-                f"{where}range[{var!r}]: a full scale is given for acc, gyr or mag only"
-            )
-        if var not in cols:
-            raise ValueError(
-                f"{where}range[{var!r}] is given but {var!r} is not mapped"
-            )
-        try:
-            lo, hi = _quality.limits(value, f"{where}range[{var!r}]")
-        except ValueError as exc:
-            raise ValueError(str(exc)) from None
-        full[var] = hi if np.isclose(-lo, hi) else [lo, hi]
-    scale: dict[str, float] = {}
-    scale_in = raw.get("scale") or {}
-    if not isinstance(scale_in, Mapping):
-        raise ValueError(
-            f"{where}'scale' must map variables to factors, e.g. "
-            '{"acc": 0.001} for a column in mg read as g'
-        )
-    for var, value in scale_in.items():
-        if var not in cols or var == "q_ref":
-            raise ValueError(
-                f"{where}scale[{var!r}]: a factor is given for a mapped acc, gyr, mag "
-                "or temp only"
-            )
-        scale[var] = _validate.positive(value, f"{where}scale[{var!r}]")
-    gaps = raw.get("gaps") or "raise"
-    if gaps not in GAP_POLICIES:
-        raise ValueError(
-            f"{where}gaps must be one of {', '.join(map(repr, GAP_POLICIES))}, got {gaps!r}"
-        )
-    attrs = raw.get("attrs") or {}
-    if not isinstance(attrs, Mapping):
-        raise ValueError(
-            f"{where}'attrs' must be a mapping of attribute names to values"
-        )
-    read_kwargs = {k: v for k, v in raw.items() if k in allowed_read}
-    nested = raw.get("read_csv") or {}
-    if not isinstance(nested, Mapping):
-        raise ValueError(
-            f"{where}'read_csv' must be a mapping of pandas.read_csv options"
-        )
-    bad = [k for k in nested if k not in allowed_read]
-    if bad:
-        raise ValueError(
-            f"{where}'read_csv' has option(s) pandas.read_csv does not take or tiltlab sets itself: {bad}"
-        )
-    read_kwargs.update(nested)
-    return {
-        "columns": cols,
-        "units": units,
-        "fs": fs,
-        "time_column": time_column,
-        "time_scale": float(time_scale),
-        "fs_range": fs_range,
-        "range": full,
-        "scale": scale,
-        "gaps": gaps,
-        "attrs": dict(attrs),
-        "read_csv": read_kwargs,
-    }
+    "read_csv_mapping",
+    "TIME_UNITS",
+    "FS_RANGE",
+    "GAP_POLICIES",
+    "CLOCK_POLICIES",
+    "MAX_GAP",
+]
 
 
 def read_csv_mapping(mapping: Mapping[str, Any] | PathLike) -> dict[str, Any]:
@@ -312,32 +45,45 @@ def read_csv_mapping(mapping: Mapping[str, Any] | PathLike) -> dict[str, Any]:
               "sep": ";"
             }
 
-        Keys: ``columns`` (variable → column name(s); ``acc`` and ``gyr`` required,
-        ``mag``, ``temp`` and ``q_ref`` optional) and ``units`` (variable → unit) are
-        required; ``fs`` (Hz) or ``time_column`` (or both) must be given;
-        ``time_units`` (``"s"``, ``"ms"``, ``"us"``; also accepted as
-        ``units["time"]``) or ``time_scale`` (factor to seconds) give the unit of the
-        time column (default seconds); ``fs_range`` ([low, high] Hz, ``null`` to
-        disable) bounds a plausible sampling rate; ``range`` (variable → full scale in
-        its units, ``r`` for ±r or ``[low, high]``, for ``acc``, ``gyr``, ``mag``) is the
-        sensor's measurement range, used to find clipped samples; ``scale`` (variable →
-        positive factor from the column's numbers to ``units``, for ``acc``, ``gyr``,
-        ``mag``, ``temp``; e.g. ``{"acc": 0.001}`` for a column in mg with
-        ``units["acc"] = "g"``, or 1/16384 g per count for raw counts at ±2 g) converts
-        columns in units tiltlab does not name; ``gaps`` (``"raise"`` or ``"nan"``,
-        see :func:`read_csv`) handles samples missing from the time column; ``attrs``
-        are extra
-        Recording attributes; any other key is a :func:`pandas.read_csv` option (``sep``,
-        ``decimal``, ``skiprows``, ``comment``, ``encoding``…), or put them under
-        ``read_csv``.
+        Keys:
+
+        * ``columns`` (required): variable → column name(s). ``acc`` is required;
+          ``gyr``, ``mag``, ``temp`` and ``q_ref`` (four columns, scalar first) are
+          optional. With a header of several rows (``"header": [0, 1]``) a column is
+          named by its levels joined with ``/``, e.g. ``"left_sensor/acc_x"``.
+        * ``units`` (required): variable → unit, for every mapped variable but
+          ``q_ref``; tiltlab never assumes one.
+        * ``fs`` (Hz) or ``time_column`` (or both).
+        * ``time_units``: ``"s"`` (default), ``"ms"``, ``"us"``, ``"ns"``, or
+          ``"datetime"`` for date-time text; also accepted as ``units["time"]``, or
+          ``time_scale`` (factor to seconds). Epoch times are recognised (see
+          :func:`read_csv`).
+        * ``clock``: ``"grid"`` (default) or ``"resample"``; ``max_gap`` (sample
+          periods, default 5); ``gaps``: ``"raise"`` (default) or ``"nan"`` (see
+          :func:`read_csv`).
+        * ``fs_range``: [low, high] Hz of a plausible rate (``null`` disables).
+        * ``range``: variable → full scale in its units (``r`` for ±r, or
+          ``[low, high]``; acc, gyr, mag), used to find clipped samples.
+        * ``scale``: variable → positive factor from the column's numbers to
+          ``units`` (acc, gyr, mag, temp), e.g. ``{"acc": 0.001}`` for a column in mg
+          with ``units["acc"] = "g"``, or 1/16384 g per count for raw counts at ±2 g.
+        * ``check_units`` (true/false), ``axes``, ``preset``, ``axis_labels``: passed
+          to :func:`tiltlab.schema.make_recording` (device axes and sign conventions,
+          :mod:`tiltlab.axes`).
+        * ``attrs``: extra Recording attributes.
+        * any other key is a :func:`pandas.read_csv` option (``sep``, ``decimal``,
+          ``skiprows``, ``comment``, ``encoding``, ``header`` …), or put them under
+          ``read_csv``.
 
     Returns
     -------
     dict
         Keys ``columns`` (variable → list of names), ``units`` (canonical spellings),
-        ``fs`` (float or None), ``time_column``, ``time_scale`` (factor to seconds),
-        ``fs_range``, ``range`` (variable → full scale), ``scale`` (variable →
-        factor), ``gaps``, ``attrs`` and ``read_csv`` (options for :func:`pandas.read_csv`).
+        ``time_column``, ``time_scale`` (factor to seconds; None for date-times),
+        ``time_units`` (the unit's name, or None for another factor), ``range``,
+        ``scale``, ``fs`` (float or None), ``fs_range``, ``gaps``, ``clock``,
+        ``max_gap``, ``check_units``, ``axes``, ``preset``, ``axis_labels``, ``attrs``
+        and ``read_csv`` (options for :func:`pandas.read_csv`).
 
     Raises
     ------
@@ -346,44 +92,114 @@ def read_csv_mapping(mapping: Mapping[str, Any] | PathLike) -> dict[str, Any]:
     ValueError
         If the JSON is invalid or the mapping is incomplete or inconsistent; the
         message names the key.
+
+    Examples
+    --------
+    >>> from tiltlab import io
+    >>> m = io.read_csv_mapping({"columns": {"acc": ["ax", "ay", "az"]},
+    ...                          "units": {"acc": "g"}, "fs": 50})
+    >>> m["columns"]["acc"], m["clock"], m["gaps"]
+    (['ax', 'ay', 'az'], 'grid', 'raise')
     """
-    raw, where = _load_mapping(mapping)
-    return _check_mapping(raw, where)
+    raw, where = load_mapping(mapping)
+    return check_mapping(raw, where)
 
 
-def _check_time(time: np.ndarray, column: str, path: Path) -> None:
-    if not np.all(np.isfinite(time)):
-        raise schema.RecordingError(
-            f"{path}: time column {column!r} has non-finite values"
-        )
-    step = np.diff(time)
-    if np.any(step <= 0):
-        i = int(np.argmax(step <= 0))
-        raise schema.RecordingError(
-            f"{path}: time column {column!r} is not strictly increasing "
-            f"(data row {i + 1}: {time[i + 1]!r} after {time[i]!r})"
-        )
+def _flat(name: Any) -> str:
+    """A column name, the levels of a multi-row header joined with ``/``."""
+    if isinstance(name, tuple):
+        return "/".join(str(level) for level in name)
+    return str(name)
 
 
-_TIME_NAMES = {"s": "seconds", "ms": "milliseconds", "us": "microseconds"}
-
-
-def _unit_hint(
-    raw_step: float, fs_range: tuple[float, float] | None, scale: float | None = None
-) -> str:
-    """Which time unit (other than the one in use, factor ``scale`` to seconds) would
-    make the median step a plausible sampling interval."""
-    lo, hi = fs_range or FS_RANGE
-    for unit, factor in TIME_UNITS.items():
-        if scale is not None and np.isclose(factor, scale):
-            continue
-        f = 1.0 / (raw_step * factor)
-        if lo <= f <= hi:
-            return (
-                f"; the time column looks like {_TIME_NAMES[unit]}: give "
-                f"time_units={unit!r} (fs would be {f:.6g} Hz)"
+def _numeric(values: pd.Series, name: str, path: Path) -> np.ndarray:
+    """A column as numbers, refusing text and empty fields with the data row."""
+    num = pd.to_numeric(values, errors="coerce")
+    bad = num.isna().to_numpy()
+    if bad.any():
+        row = int(np.argmax(bad))
+        text = values.iat[row]
+        if pd.isna(text) or str(text).strip() == "":
+            raise ReadError(
+                f"{path}: empty field in column {name!r}, data row {row} (truncated file?)"
             )
-    return ""
+        raise ReadError(
+            f"{path}: non-numeric value {text!r} in column {name!r}, data row {row}"
+        )
+    return num.to_numpy()
+
+
+def read_frame(
+    path: Path,
+    wanted: Sequence[str],
+    roles: Mapping[str, str],
+    text: Sequence[str] = (),
+    **read_kwargs,
+) -> dict[str, np.ndarray]:
+    """Read the ``wanted`` columns of a CSV: numbers (integers kept as integers), or
+    the raw values for the columns in ``text``. A header of several rows is flattened
+    (levels joined with ``/``)."""
+    if not path.is_file():
+        raise ReadError(f"{path}: no such file")
+    header = read_kwargs.get("header", "infer")
+    multi = isinstance(header, (list, tuple)) and len(header) > 1
+    want = set(wanted)
+    kwargs = dict(read_kwargs)
+    if not multi and not kwargs.get("index_col"):
+        kwargs["usecols"] = lambda c: str(c) in want
+    try:
+        df = pd.read_csv(path, **kwargs)
+    except (
+        pd.errors.ParserError,
+        pd.errors.EmptyDataError,
+        UnicodeDecodeError,
+        ValueError,
+        TypeError,
+    ) as exc:
+        raise ReadError(f"{path}: not a readable CSV table ({exc})") from None
+    df.columns = [_flat(c) for c in df.columns]
+    missing = [c for c in wanted if c not in df.columns]
+    if missing:
+        if "usecols" in kwargs:  # name every column of the file in the message
+            kwargs.pop("usecols")
+            try:
+                df = pd.read_csv(path, **{**kwargs, "nrows": 0})
+            except (pd.errors.ParserError, pd.errors.EmptyDataError, ValueError):
+                pass
+            df.columns = [_flat(c) for c in df.columns]
+        msg = _missing_columns_message(path, df, missing, roles)
+        if not multi and any("/" in c for c in missing):
+            msg += (
+                " (a name written 'level1/level2' is a column of a header of several "
+                "rows: give header=[0, 1])"
+            )
+        raise ReadError(msg)
+    if len(df) < 2:
+        raise ReadError(f"{path}: fewer than two samples")
+    out = {}
+    for c in wanted:
+        col = df[c]
+        if isinstance(col, pd.DataFrame):
+            raise ReadError(f"{path}: column {c!r} appears more than once")
+        out[c] = col.to_numpy() if c in text else _numeric(col, c, path)
+    return out
+
+
+def _merge_arguments(
+    raw: dict[str, Any], explicit: Mapping[str, Any], read_kwargs: dict[str, Any]
+) -> None:
+    """Put keyword arguments given explicitly into the raw mapping (they win)."""
+    for key, value in explicit.items():
+        if value is not None:
+            raw[key] = value
+    for key in ("range", "scale"):  # as in a mapping
+        if key in read_kwargs:
+            raw[key] = read_kwargs.pop(key)
+    nested = read_kwargs.pop("read_csv", None) or {}
+    if not isinstance(nested, Mapping):
+        raise ValueError("read_csv must be a mapping of pandas.read_csv options")
+    if read_kwargs or nested:
+        raw["read_csv"] = {**(raw.get("read_csv") or {}), **nested, **read_kwargs}
 
 
 def read_csv(
@@ -397,6 +213,13 @@ def read_csv(
     time_scale: float | None = None,
     time_units: str | None = None,
     fs_range: tuple[float, float] | None = FS_RANGE,
+    clock: str | None = None,
+    max_gap: float | None = None,
+    gaps: str | None = None,
+    check_units: bool | None = None,
+    axes: Sequence[str] | Mapping[str, Sequence[str]] | None = None,
+    preset: str | None = None,
+    axis_labels: Sequence[str] | None = None,
     attrs: Mapping[str, Any] | None = None,
     **read_kwargs,
 ) -> xr.Dataset:
@@ -408,41 +231,77 @@ def read_csv(
         CSV file.
     columns : mapping, optional
         Variable → column names, e.g. ``{"acc": ["AccX", "AccY", "AccZ"], "gyr": [...],
-        "temp": "T"}``. ``acc`` and ``gyr`` are required; ``mag``, ``temp`` and ``q_ref``
-        (four columns, scalar first) are optional. Not needed when ``mapping`` gives them.
+        "temp": "T"}``. ``acc`` is required; ``gyr``, ``mag``, ``temp`` and ``q_ref``
+        (four columns, scalar first) are optional (a tag without gyroscope gives a
+        valid Recording). With a header of several rows (``header=[0, 1]``) name a
+        column by its levels joined with ``/``: ``"left_sensor/acc_x"``. Not needed
+        when ``mapping`` gives them.
     units : mapping, optional
         Variable → unit string, e.g. ``{"acc": "m/s^2", "gyr": "rad/s"}``; required for
         every physical variable in ``columns`` (no unit is assumed). ``"time"`` may give
         the unit of the time column (as ``time_units``).
     mapping : dict or path-like, optional
-        A whole mapping (``columns``, ``units``, ``fs``, ``time_column``, ``time_units``
-        …, see :func:`read_csv_mapping`), or the path of a JSON file holding one.
-        Arguments given explicitly override it (``units`` and ``attrs`` are merged); its
-        ``range`` (variable → the sensor's full scale) and ``scale`` (variable → factor
-        from the column's numbers to its ``units``, e.g. ``{"acc": 0.001}`` for mg) may
-        also be given as keywords. The factors are kept in ``attrs['csv_scale']``.
-        So may ``gaps``: ``"raise"`` (default) refuses a time column that skips samples
-        (steps longer than 1.5/fs, a logger that dropped samples); ``"nan"`` inserts
-        NaN rows in their place, keeps a description in ``attrs['gaps']`` and
-        validates with ``allow_nan``.
+        A whole mapping (:func:`read_csv_mapping`), or the path of a JSON file holding
+        one. Arguments given explicitly override it (``units`` and ``attrs`` are
+        merged). Its ``range`` (variable → the sensor's full scale) and ``scale``
+        (variable → factor from the column's numbers to its ``units``, e.g.
+        ``{"acc": 0.001}`` for mg; kept in ``attrs['csv_scale']``) may also be given as
+        keywords. When the options come from a mapping, error messages name the fix as
+        a JSON key (``"clock": "resample"``), else as a keyword (``clock='resample'``).
     fs : float, optional
         Sampling rate (Hz). If omitted, ``time_column`` is required and ``fs`` is
-        estimated as 1 / median interval, to 7 significant digits (recorded in
-        ``attrs['fs_source']``).
+        estimated (recorded in ``attrs['fs_source']``): with ``clock="grid"`` as
+        1 / median step, with ``clock="resample"`` as (samples − 1) / duration leaving
+        out the real gaps; to 7 significant digits.
     time_column : str, optional
         Column with sample times.
     time_scale : float, optional
         Factor converting the time column to seconds (e.g. ``1e-3`` for ms).
-    time_units : {"s", "ms", "us"}, optional
+    time_units : {"s", "ms", "us", "ns", "datetime"}, optional
         Unit of the time column; an alternative to ``time_scale``. Default seconds.
+        ``"datetime"`` parses date-time text (:func:`pandas.to_datetime`; read as UTC
+        when no zone is written). Epoch times (numbers whose first sample, in the given
+        unit, falls between 1980 and 2100) and date-times are made relative to the first
+        sample, whose absolute time is kept in ``attrs['time_origin']`` (ISO 8601, UTC).
     fs_range : (float, float) or None
         Plausible sampling rates (Hz). A rate outside it — estimated, or given and
         contradicted by the time column — is an error that suggests the time unit that
         would fit. ``None`` disables the check.
+    clock : {"grid", "resample"}, optional
+        ``"grid"`` (default): the samples must sit on a ``k / fs`` grid, and steps of
+        several periods are dropped samples, handled by ``gaps``. ``"resample"``: for
+        real clocks that jitter, drift or arrive in bursts; every variable is
+        interpolated linearly onto the uniform grid ``t0 + k / fs`` spanning the time
+        column, and ``attrs['resampled']`` says so (original sample count, median and
+        longest step). Linear interpolation is used because it never overshoots,
+        needs no assumption on the signal beyond its samples and keeps a still sensor
+        exactly still; it attenuates high frequencies (a sine at f sampled every T
+        loses up to ``1 − sinc²(f T)`` of its amplitude between samples, about 3 % at
+        f T = 0.1) and does not remove aliasing: when ``fs`` is much lower than the
+        clock's rate a :class:`~tiltlab.quality.QualityWarning` says to low-pass
+        filter first.
+    max_gap : float, optional
+        With ``clock="resample"``: the longest step, in sample periods of the time
+        column's own rate, that is interpolated across (default 5). A longer step is a
+        real gap, handled by ``gaps``.
+    gaps : {"raise", "nan"}, optional
+        What to do with samples missing from the time column (a logger that dropped
+        samples: steps longer than 1.5 periods on a grid clock, longer than
+        ``max_gap`` periods on a resampled one). ``"raise"`` (default) refuses the file
+        with the gaps located; ``"nan"`` puts NaN rows on the grid in their place, keeps
+        a description in ``attrs['gaps']`` and validates with ``allow_nan``.
+    check_units : bool, optional
+        Passed to :func:`tiltlab.schema.make_recording` (default True). A
+        :class:`~tiltlab.quality.UnitCheckError` names the switch as the options were
+        given (``"check_units": false`` in a mapping, ``check_units=False`` here).
+    axes, preset, axis_labels : optional
+        Device axes and sign conventions, passed to
+        :func:`tiltlab.schema.make_recording` (e.g. ``axes={"acc": ["-x", "-y", "-z"]}``
+        for a logger that reports gravity instead of specific force).
     attrs : mapping, optional
         Extra dataset attributes (provenance).
     **read_kwargs
-        Passed to :func:`pandas.read_csv` (e.g. ``sep=';'``).
+        Passed to :func:`pandas.read_csv` (e.g. ``sep=';'``, ``header=[0, 1]``).
 
     Returns
     -------
@@ -457,29 +316,40 @@ def read_csv(
     ValueError
         If the mapping is incomplete or inconsistent, or the sampling rate implausible.
     RecordingError
-        If the data break the Recording contract, or the time column skips samples
-        (unless ``gaps="nan"``).
+        If the data break the Recording contract, if the time column skips samples
+        (unless ``gaps="nan"``), or if it is not on a regular grid with
+        ``clock="grid"`` (the message suggests ``clock="resample"``).
+
+    Examples
+    --------
+    >>> import numpy as np, tempfile, pathlib
+    >>> from tiltlab import io
+    >>> t = np.cumsum(np.r_[0, np.full(199, 0.01) * (1 + 0.2 * np.sin(np.arange(199)))])
+    >>> rows = ["t,ax,ay,az"] + [f"{x:.6f},0,0,1" for x in t]
+    >>> p = pathlib.Path(tempfile.mkdtemp()) / "log.csv"
+    >>> _ = p.write_text("\\n".join(rows))
+    >>> rec = io.read_csv(p, {"acc": ["ax", "ay", "az"]}, {"acc": "g"},
+    ...                   time_column="t", clock="resample", fs=100)
+    >>> rec.attrs["fs"], bool(np.allclose(np.diff(rec.time), 0.01))
+    (100.0, True)
     """
     path = Path(path)
     raw: dict[str, Any] = {}
     where = ""
     if mapping is not None:
-        raw, where = _load_mapping(mapping)
+        raw, where = load_mapping(mapping)
     elif columns is not None and (
         isinstance(columns, (str, os.PathLike))
         or (isinstance(columns, Mapping) and "columns" in columns)
     ):
         # read_csv(path, "mapping.json") or read_csv(path, {"columns": ..., "units": ...})
-        raw, where = _load_mapping(columns)
+        raw, where = load_mapping(columns)
         columns = None
+    style = "mapping" if where else "python"
     if columns is not None:
         raw["columns"] = columns
     if units is not None:
         raw["units"] = {**(raw.get("units") or {}), **units}
-    if fs is not None:
-        raw["fs"] = fs
-    if time_column is not None:
-        raw["time_column"] = time_column
     if time_scale is not None or time_units is not None:
         for k in ("time_scale", "time_units"):
             raw.pop(k, None)
@@ -490,66 +360,116 @@ def read_csv(
         raw["fs_range"] = fs_range
     if attrs:
         raw["attrs"] = {**(raw.get("attrs") or {}), **attrs}
-    if "range" in read_kwargs:  # the sensor's full scale, as in a mapping
-        raw["range"] = read_kwargs.pop("range")
-    if "scale" in read_kwargs:  # factors from the columns' numbers to the units
-        raw["scale"] = read_kwargs.pop("scale")
-    if "gaps" in read_kwargs:  # what to do with samples the logger dropped
-        raw["gaps"] = read_kwargs.pop("gaps")
-    nested = read_kwargs.pop("read_csv", None) or {}
-    if not isinstance(nested, Mapping):
-        raise ValueError("read_csv must be a mapping of pandas.read_csv options")
-    if read_kwargs or nested:
-        raw["read_csv"] = {**(raw.get("read_csv") or {}), **nested, **read_kwargs}
-    m = _check_mapping(raw, where)
+    explicit = {
+        "fs": fs,
+        "time_column": time_column,
+        "clock": clock,
+        "max_gap": max_gap,
+        "gaps": gaps,
+        "check_units": check_units,
+        "axes": axes,
+        "preset": preset,
+        "axis_labels": axis_labels,
+    }
+    _merge_arguments(raw, explicit, read_kwargs)
+    m = check_mapping(raw, where)
     cols, tcol = m["columns"], m["time_column"]
     roles = {c: var for var, names in cols.items() for c in names}
     if tcol:
         roles.setdefault(tcol, "time_column")
-    df = _read_table(path, list(roles), roles=roles, **m["read_csv"])
-    get = {k: df[v].to_numpy(float) * m["scale"].get(k, 1.0) for k, v in cols.items()}
-    time = None
+    data = read_frame(
+        path,
+        list(roles),
+        roles,
+        text=[tcol] if m["time_units"] == _clock.DATETIME else (),
+        **m["read_csv"],
+    )
+    get = {
+        k: np.column_stack([data[c] for c in v]).astype(float) * m["scale"].get(k, 1.0)
+        for k, v in cols.items()
+    }
     extra_attrs = dict(m["attrs"])
     if m["scale"]:
         extra_attrs["csv_scale"] = dict(m["scale"])
-    fs, lo_hi = m["fs"], m["fs_range"]
+    fs, time, allow_nan = m["fs"], None, False
     if tcol:
-        raw_time = df[tcol].to_numpy(float)
-        time = raw_time * m["time_scale"]
-        _check_time(time, tcol, path)
-        raw_step = float(np.median(np.diff(raw_time)))
-        fs_est = 1.0 / (raw_step * m["time_scale"])
-        unit = next(
-            (u for u, f in TIME_UNITS.items() if np.isclose(f, m["time_scale"])),
-            f"× {m['time_scale']:g} s",
-        )
-        if fs is None:
-            if lo_hi is not None and not lo_hi[0] <= fs_est <= lo_hi[1]:
-                raise ValueError(
-                    f"{path}: sampling rate estimated from time column {tcol!r} ({unit}) is "
-                    f"{fs_est:.6g} Hz, outside the plausible range {lo_hi[0]:g}–{lo_hi[1]:g} Hz"
-                    + (
-                        _unit_hint(raw_step, lo_hi, m["time_scale"])
-                        or "; give fs, or widen fs_range"
-                    )
-                )
-            # 7 significant digits: the median of parsed intervals carries rounding noise
-            fs = float(f"{fs_est:.7g}")
-            extra_attrs["fs_source"] = f"estimated from column {tcol!r} ({unit})"
-        elif not np.isclose(fs_est, fs, rtol=0.02):
-            raise ValueError(
-                f"{path}: fs = {fs:g} Hz but time column {tcol!r} ({unit}) gives "
-                f"{fs_est:.6g} Hz (median interval {raw_step:g} {unit})"
-                + _unit_hint(raw_step, (0.98 * fs, 1.02 * fs), m["time_scale"])
-            )
+        time, fs, allow_nan = _apply_clock(data[tcol], get, m, path, extra_attrs, style)
+    lo_hi = m["fs_range"]
     if lo_hi is not None and not lo_hi[0] <= fs <= lo_hi[1]:
         raise ValueError(
             f"{path}: fs = {fs:g} Hz is outside the plausible range {lo_hi[0]:g}–{lo_hi[1]:g} Hz "
             "(give fs_range to accept it)"
         )
+    return build_recording(
+        get,
+        fs,
+        m,
+        time=time,
+        attrs={"source": path.name, **extra_attrs},
+        allow_nan=allow_nan,
+        style=style,
+    )
+
+
+def _apply_clock(
+    raw_time: np.ndarray,
+    get: dict[str, np.ndarray],
+    m: Mapping[str, Any],
+    path: Path,
+    extra_attrs: dict[str, Any],
+    style: str,
+) -> tuple[np.ndarray, float, bool]:
+    """Time in seconds on a uniform (or exact) grid; ``get`` is updated in place."""
+    tcol, scale = m["time_column"], m["time_scale"]
+    where = f"{path}: "
+    time, origin = _clock.to_seconds(
+        raw_time, _clock.DATETIME if scale is None else scale, where
+    )
+    if origin is not None:
+        extra_attrs["time_origin"] = _clock.iso_utc(origin)
+    _clock.check_increasing(time, tcol, where)
+    unit = m["time_units"] or _clock.unit_name(scale)
+    raw_scale = 1.0 if scale is None else scale
+    fs, lo_hi = m["fs"], m["fs_range"]
+    resample = m["clock"] == "resample"
+    if resample:
+        fs_est, n_gaps = _clock.estimate_rate(time, m["max_gap"])
+        how = f"(samples − 1) / duration of column {tcol!r} ({unit})" + (
+            f", leaving out {n_gaps} gap{'s' * (n_gaps != 1)}" if n_gaps else ""
+        )
+    else:
+        fs_est = 1.0 / float(np.median(np.diff(time)))
+        how = f"1 / median step of column {tcol!r} ({unit})"
+    raw_step = 1.0 / (fs_est * raw_scale)
+
+    def hint(rates: tuple[float, float] | None) -> str:
+        if scale is None:  # date-times: no other unit to suggest
+            return ""
+        return _clock.unit_hint(raw_step, rates, scale, style)
+
+    if fs is None or resample:
+        if lo_hi is not None and not lo_hi[0] <= fs_est <= lo_hi[1]:
+            raise ValueError(
+                f"{path}: sampling rate estimated from time column {tcol!r} ({unit}) is "
+                f"{fs_est:.6g} Hz, outside the plausible range {lo_hi[0]:g}–{lo_hi[1]:g} Hz"
+                + (hint(lo_hi) or "; give fs, or widen fs_range")
+            )
+    if fs is None:
+        # 7 significant digits: the estimate carries the rounding noise of the column
+        fs = float(f"{fs_est:.7g}")
+        extra_attrs["fs_source"] = f"estimated as {how}"
+    elif not resample and not np.isclose(fs_est, fs, rtol=0.02):
+        raise ValueError(
+            f"{path}: fs = {fs:g} Hz but time column {tcol!r} ({unit}) gives "
+            f"{fs_est:.6g} Hz (median interval {raw_step:g} {unit})"
+            + hint((0.98 * fs, 1.02 * fs))
+        )
     allow_nan = False
-    if time is not None:
-        time, get, missing = _place_on_grid(time, get, fs, tcol, path, m["gaps"])
+    if not resample:
+        time, new, missing = _clock.place_on_grid(
+            time, get, fs, tcol, where, m["gaps"], style
+        )
+        get.update(new)
         if missing:
             allow_nan = True
             extra_attrs["gaps"] = (
@@ -558,65 +478,64 @@ def read_csv(
                     time, fs, _validate.segments(time, fs, values=get["acc"])
                 )
             )
-    return schema.make_recording(
-        get["acc"],
-        get["gyr"],
-        fs,
-        acc_units=m["units"]["acc"],
-        gyr_units=m["units"]["gyr"],
-        mag=get.get("mag"),
-        mag_units=m["units"].get("mag", "uT"),
-        acc_range=m["range"].get("acc"),
-        gyr_range=m["range"].get("gyr"),
-        mag_range=m["range"].get("mag"),
-        temp=get["temp"][:, 0] if "temp" in get else None,
-        temp_units=m["units"].get("temp", "degC"),
-        q_ref=get.get("q_ref"),
-        time=time,
-        attrs={"source": path.name, **extra_attrs},
-        allow_nan=allow_nan,
-    )
-
-
-def _place_on_grid(
-    time: np.ndarray,
-    get: dict[str, np.ndarray],
-    fs: float,
-    tcol: str,
-    path: Path,
-    gaps: str,
-) -> tuple[np.ndarray, dict[str, np.ndarray], int]:
-    """Find samples missing from a time column (steps of about k/fs, k ≥ 2): refuse
-    them (``gaps="raise"``) or insert NaN rows in their place (``"nan"``); return the
-    time, the columns and the number of samples inserted."""
-    segs = _validate.segments(time, fs)
-    if len(segs) <= 1:
-        return time, get, 0
-    pos = (time - time[0]) * fs
-    k = np.rint(pos).astype(np.int64)
-    n_missing = int(k[-1] + 1 - k.size)
-    where = _validate.describe_gaps(time, fs, segs)
-    if gaps == "raise":
-        raise schema.RecordingError(
-            f"{path}: time column {tcol!r} skips samples ({where}"
-            + (f"; about {n_missing} samples missing" if n_missing > 0 else "")
-            + "): the logger dropped samples, or fs is wrong. "
-            "Read with gaps='nan' to keep the gaps as NaN rows (orientation filters "
-            "then run on each gap-free segment, estimate(..., gaps='segments'))"
-        )
-    if np.any(np.abs(pos - k) > 0.35) or np.any(np.diff(k) < 1):
-        i = int(np.argmax((np.abs(pos - k) > 0.35) | np.r_[False, np.diff(k) < 1]))
-        raise schema.RecordingError(
-            f"{path}: time column {tcol!r} is not on a regular grid of 1/fs = "
-            f"{1 / fs:.6g} s (data row {i}: {pos[i]:.2f} sample periods after the "
-            "first); cannot place the gaps, give the right fs"
-        )
-    n = int(k[-1] + 1)
-    full_time = time[0] + np.arange(n) / fs
-    full_time[k] = time
-    out = {}
+        return time, fs, allow_nan
+    gap_idx = _clock.gap_steps(time, fs_est, m["max_gap"])
+    if gap_idx.size and m["gaps"] == "raise":
+        _clock.raise_gaps(time, gap_idx, fs_est, m["max_gap"], tcol, where, style)
+    _clock.warn_if_downsampled(fs, fs_est, str(path))
+    grid = _clock.uniform_grid(time[0], time[-1], fs)
     for var, v in get.items():
-        filled = np.full((n, *v.shape[1:]), np.nan)
-        filled[k] = v
-        out[var] = filled
-    return full_time, out, n - k.size
+        get[var] = _clock.interpolate(time, v, grid, gap_idx, quaternion=var == "q_ref")
+    extra_attrs["resampled"] = _clock.describe_resampling(time, grid.size, fs)
+    if gap_idx.size:
+        allow_nan = True
+        n_nan = int(np.isnan(get["acc"][:, 0]).sum())
+        extra_attrs["gaps"] = (
+            f"{n_nan} grid sample{'s' if n_nan != 1 else ''} in {gap_idx.size} gap"
+            f"{'s' if gap_idx.size != 1 else ''} longer than {m['max_gap']:g} periods "
+            "filled with NaN; "
+            + _validate.describe_gaps(
+                grid, fs, _validate.segments(grid, fs, values=get["acc"])
+            )
+        )
+    return grid, fs, allow_nan
+
+
+def build_recording(
+    get: Mapping[str, np.ndarray],
+    fs: float,
+    m: Mapping[str, Any],
+    *,
+    time: np.ndarray | None,
+    attrs: Mapping[str, Any],
+    allow_nan: bool,
+    style: str,
+) -> xr.Dataset:
+    """:func:`tiltlab.schema.make_recording` with a mapping's options; a unit-check
+    error names the switch in the form the options were given."""
+    units, full = m["units"], m["range"]
+    try:
+        return schema.make_recording(
+            get["acc"],
+            get.get("gyr"),
+            fs,
+            acc_units=units["acc"],
+            gyr_units=units.get("gyr"),
+            mag=get.get("mag"),
+            mag_units=units.get("mag"),
+            acc_range=full.get("acc"),
+            gyr_range=full.get("gyr"),
+            mag_range=full.get("mag"),
+            temp=get["temp"][:, 0] if "temp" in get else None,
+            temp_units=units.get("temp"),
+            q_ref=get.get("q_ref"),
+            time=time,
+            axes=m["axes"],
+            preset=m["preset"],
+            axis_labels=m["axis_labels"],
+            attrs=attrs,
+            check_units=m["check_units"],
+            allow_nan=allow_nan,
+        )
+    except _quality.UnitCheckError as err:
+        raise err.for_switch(style) from None

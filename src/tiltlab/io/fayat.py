@@ -40,6 +40,7 @@ def read_fayat_imu(
         fs,
         acc_units="g",
         gyr_units="deg/s",
+        preset="rat_head",
         time=time,
         extra={
             "counter": (

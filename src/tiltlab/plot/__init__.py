@@ -37,6 +37,8 @@ from .mapfigures import (
 )
 from .maps import (
     SENSOR_AXES,
+    axis_names,
+    axis_texts,
     decorate,
     laea,
     lonlat_deg,
@@ -83,6 +85,8 @@ __all__ = [
     "plot_mask",
     "plot_points",
     "decorate",
+    "axis_names",
+    "axis_texts",
     "sphere_3d",
     "map_grid",
     "facet_map",

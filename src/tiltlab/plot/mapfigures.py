@@ -12,6 +12,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 import xarray as xr
 
+from .. import axes as _axes
 from .. import sphere as S
 from ._common import label, legend_if_many, units_of
 from .maps import (
@@ -24,6 +25,7 @@ from .maps import (
     plot_isopleths,
     plot_points,
     decorate,
+    axis_names,
     sphere_3d,
 )
 
@@ -146,6 +148,7 @@ def facet_map(
     cmap="viridis",
     colorbar: bool = True,
     decorate_kw: dict | None = None,
+    axis_labels=None,
     title: str | None = None,
     **kw,
 ):
@@ -168,6 +171,9 @@ def facet_map(
     colorbar : bool
     decorate_kw : dict, optional
         Passed to :func:`decorate`.
+    axis_labels : data or sequence of 3 str, optional
+        What the sensor axes point to (:func:`axis_names`); default read from
+        ``values``' attrs, else plain ``+x``, ``+y``, ``+z``.
     title : str, optional
     **kw
         Passed to :func:`plot_facets`.
@@ -177,6 +183,8 @@ def facet_map(
     GeoAxes
     """
     ax = _map_ax(ax)
+    if axis_labels is None and isinstance(values, xr.DataArray):
+        axis_labels = values
     name = (
         name
         or (values.attrs.get("long_name") if isinstance(values, xr.DataArray) else None)
@@ -189,7 +197,7 @@ def facet_map(
             v = np.where(v > 0, np.log10(v), np.nan)
         name = f"log10 {name}"
     art = plot_facets(ax, v, mesh, cmap=cmap, **kw)
-    decorate(ax, **(decorate_kw or {}))
+    decorate(ax, **({"axis_labels": axis_labels} | (decorate_kw or {})))
     if colorbar:
         _colorbar(ax, art, label(name, units))
     if title:
@@ -214,7 +222,8 @@ def tilt_heatmap(
     ----------
     tilt : xarray.Dataset, xarray.DataArray or array_like
         A tilt map (:func:`tiltlab.sphere.tilt_map`) or tilt vectors to map (a labelled
-        (time, axis) series with ``fs``, a Recording with ``gravity``, or an (N, 3) array).
+        (time, axis) series with ``fs``, a Recording with ``gravity``, or an (N, 3)
+        array). Its ``attrs["axis_labels"]`` name the sensor axes on the map.
     mesh : SphereMesh, optional
         The map's mesh (default the mesh with the map's ``n_vertices``, or 5000 vertices).
     quantity : {"fraction", "time", "count", "density"}
@@ -241,6 +250,7 @@ def tilt_heatmap(
             f"the map has no {quantity!r} (the sampling rate fs is unknown); use quantity='fraction'"
         )
     da = tmap[quantity].where(tmap["count"] > 0)
+    kw.setdefault("axis_labels", _axes.axis_labels(tmap))
     return facet_map(
         da,
         mesh,
@@ -348,6 +358,8 @@ def visited_map(
     min_count : int
     legend : bool
     decorate_kw : dict, optional
+        Passed to :func:`decorate`; the sensor axes are named from the first series
+        whose attrs have ``axis_labels``.
     title : str, optional
 
     Returns
@@ -363,8 +375,10 @@ def visited_map(
         else ["tab:green", "tab:red", "tab:blue", "tab:orange", "tab:purple"]
     )
     handles = []
+    names = None
     for k, (name, data) in enumerate(series.items()):
         tmap, m = _as_map(data, mesh)
+        names = names or tmap.attrs.get("axis_labels")
         c = colors[k % len(colors)]
         plot_mask(ax, S.visited(tmap, min_count=min_count), m, color=c, alpha=alpha)
         frac = S.visited_fraction(tmap, m, min_count=min_count)
@@ -373,7 +387,7 @@ def visited_map(
                 color=c, alpha=alpha, label=f"{name} ({100 * frac:.1f} % of the sphere)"
             )
         )
-    decorate(ax, **({"fontsize": 8} | (decorate_kw or {})))
+    decorate(ax, **({"fontsize": 8, "axis_labels": names} | (decorate_kw or {})))
     if legend:
         ax.legend(
             handles=handles,
@@ -401,6 +415,7 @@ def kde_map(
     iso_color="w",
     colorbar: bool = True,
     labels: dict | None = None,
+    axis_labels=None,
     grid_step_deg: float | None = None,
     point_kw: dict | None = None,
     title: str | None = None,
@@ -430,6 +445,9 @@ def kde_map(
     colorbar : bool
     labels : dict, optional
         Sensor-axis labels for :func:`decorate` (``{}`` for none).
+    axis_labels : data or sequence of 3 str, optional
+        What the sensor axes point to (:func:`axis_names`) when ``labels`` is not
+        given; default read from labelled ``points``, else plain ``+x``, ``+y``.
     grid_step_deg : float, optional
         Gridline spacing (default 30°, 10° for a zoomed view).
     point_kw : dict, optional
@@ -507,7 +525,9 @@ def kde_map(
         if grid_step_deg is not None
         else (10.0 if extent is not None and extent < 1 else 30.0)
     )
-    decorate(ax, labels=labels, grid_step_deg=step, fontsize=8)
+    if axis_labels is None and points is not None and hasattr(points, "attrs"):
+        axis_labels = points
+    decorate(ax, labels=labels, axis_labels=axis_labels, grid_step_deg=step, fontsize=8)
     if colorbar:
         _colorbar(ax, art, name)
     ax.legend(
@@ -531,6 +551,7 @@ def tilt_points_map(
     ax=None,
     extent: float = 0.8,
     grid_step_deg: float = 10.0,
+    axis_labels=None,
     title: str | None = None,
     **kw,
 ):
@@ -550,6 +571,8 @@ def tilt_points_map(
     extent : float
         Half-width of the view in map units.
     grid_step_deg : float
+    axis_labels : data or sequence of 3 str, optional
+        What the sensor axes point to (:func:`axis_names`); default plain ``+x``, ``+y``.
     title : str, optional
     **kw
         Marker style.
@@ -593,6 +616,7 @@ def tilt_points_map(
         fontsize=8,
         grid_step_deg=grid_step_deg,
         labels={} if baseline is not None else None,
+        axis_labels=axis_labels,
     )
     legend_if_many(ax, loc="upper center", bbox_to_anchor=(0.5, -0.02), frameon=False)
     ax.text(
@@ -608,17 +632,20 @@ def tilt_points_map(
     return ax
 
 
-def tilt_trace(tilt, *, ax=None, title: str | None = None, **kw):
-    """A tilt trajectory on the plane of the head-tilt LAEA projection (no map axes needed).
+def tilt_trace(tilt, *, ax=None, axis_labels=None, title: str | None = None, **kw):
+    """A tilt trajectory on the plane of the tilt LAEA projection (no map axes needed).
 
-    +x (nose) points up and +y (left ear) left, as seen from above the head; the dashed
-    circle of radius √2 is the horizon (tilt 90°).
+    +x points up and +y left, as seen from above; the dashed circle of radius √2 is the
+    horizon (tilt 90°). The axis titles name what +x and +y point to when the data say
+    (``attrs["axis_labels"]``: "nose (+x)" and "left (+y)" for a rat head).
 
     Parameters
     ----------
     tilt : xarray.DataArray, xarray.Dataset or array_like
         Tilt vectors (a labelled (time, axis) series, a Recording with ``gravity``, or (N, 3)).
     ax : matplotlib.axes.Axes, optional
+    axis_labels : data or sequence of 3 str, optional
+        What the sensor axes point to (:func:`axis_names`); default from ``tilt``.
     title : str, optional
     **kw
         Style of the trajectory line.
@@ -630,6 +657,7 @@ def tilt_trace(tilt, *, ax=None, title: str | None = None, **kw):
     from ._common import new_axes
 
     g = S.as_unit_vectors(tilt, "tilt", allow_nan=True)
+    nx, ny, _ = axis_names(tilt if axis_labels is None else axis_labels)
     ax = new_axes(ax, figsize=(4.5, 4.5))
     xy = project(tilt_projection(), g)
     ax.plot(
@@ -650,13 +678,18 @@ def tilt_trace(tilt, *, ax=None, title: str | None = None, **kw):
         aspect="equal",
         xlim=(-2.05, 2.05),
         ylim=(-2.05, 2.05),
-        xlabel="LAEA x: ← left ear (+y)   right ear →",
-        ylabel="LAEA y: nose (+x) ↑",
+        xlabel=f"LAEA x: ← {_named(ny, 'y')}   −y →",
+        ylabel=f"LAEA y: {_named(nx, 'x')} ↑",
     )
     ax.legend(loc="lower right", fontsize=8)
     if title:
         ax.set_title(title, fontsize=9)
     return ax
+
+
+def _named(name: str, letter: str) -> str:
+    """``"nose (+x)"`` for a named axis, ``"+x"`` for an unnamed one."""
+    return f"+{letter}" if name.lower() == letter else f"{name} (+{letter})"
 
 
 def residence_figure(

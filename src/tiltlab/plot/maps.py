@@ -4,8 +4,11 @@ isopleths, grids of maps with colour bars).
 
 Maps use cartopy's :class:`~cartopy.crs.LambertAzimuthalEqualArea` on a **unit sphere**
 (``Globe(semimajor_axis=1, semiminor_axis=1)``): longitude and latitude are those of the
-direction in the data frame (:func:`tiltlab.sphere.to_lonlat`; for tilt in the rodent
-sensor frame, longitude 0 = nose +x, +90° = left ear +y, latitude 90° = dorsal +z).
+direction in the data frame (:func:`tiltlab.sphere.to_lonlat`: longitude 0 = +x, +90° =
++y, latitude 90° = +z). What the sensor axes point to is read from the data
+(``attrs["axis_labels"]``, :func:`tiltlab.axes.axis_labels`): "+x (nose)", "+y (left)"
+for a rat head whose Recording says so, "+x (right)", "+y (top)" for a phone, plain
+"+x", "+y" when the data do not say.
 Nothing here downloads data: no coastlines or Natural Earth features are drawn (they
 mean nothing on a unit globe), only gridlines, the equator and labelled sensor axes, so
 maps render without network access and without cartopy's data directory. (A bare cartopy
@@ -26,9 +29,13 @@ References
 from __future__ import annotations
 
 
+from collections.abc import Sequence
+from typing import Any
+
 import matplotlib.pyplot as plt
 import numpy as np
 
+from .. import axes as _axes
 from .. import sphere as S
 
 __all__ = [
@@ -44,6 +51,8 @@ __all__ = [
     "plot_mask",
     "plot_points",
     "decorate",
+    "axis_names",
+    "axis_texts",
     "sphere_3d",
 ]
 
@@ -57,6 +66,64 @@ SENSOR_AXES = {
 }
 
 
+def axis_names(obj: Any = None) -> list[str]:
+    """Short names of the +x, +y, +z sensor axes, for figure labels.
+
+    Parameters
+    ----------
+    obj : Recording, DataArray, tilt map, sequence of 3 str or None
+        Data whose ``attrs["axis_labels"]`` say what the axes point to
+        (:func:`tiltlab.axes.axis_labels`), or the three names themselves; ``None`` or
+        data without labels give ``["x", "y", "z"]``.
+
+    Returns
+    -------
+    list of str
+        One name per axis; a parenthesised detail is preferred to the general word
+        (``"forward (nose)"`` → ``"nose"``, ``"up (dorsal)"`` → ``"dorsal"``), so that
+        map labels stay short.
+
+    Examples
+    --------
+    >>> axis_names(["forward (nose)", "left", "up (dorsal)"])
+    ['nose', 'left', 'dorsal']
+    >>> axis_names(None)
+    ['x', 'y', 'z']
+    """
+    if obj is None:
+        names = ["x", "y", "z"]
+    elif isinstance(obj, Sequence) and all(isinstance(x, str) for x in obj):
+        names = _axes.check_labels(obj)
+    else:
+        names = _axes.axis_labels(obj)
+    out = []
+    for name in names:
+        name = str(name).strip()
+        if "(" in name and name.endswith(")"):
+            name = name[name.index("(") + 1 : -1].strip() or name
+        out.append(name)
+    return out
+
+
+def axis_texts(obj: Any = None) -> dict[str, str]:
+    """Texts of the six sensor-axis markers drawn by :func:`decorate`.
+
+    ``"+x (nose)"`` where the data name the axis (:func:`axis_names`), ``"+x"`` where
+    they do not; negative axes are ``"−x"`` etc.
+
+    Examples
+    --------
+    >>> axis_texts(["right", "top", "out of screen"])["+y"]
+    '+y (top)'
+    """
+    out = {}
+    for letter, name in zip("xyz", axis_names(obj)):
+        plain = name.lower() == letter
+        out[f"+{letter}"] = f"+{letter}" if plain else f"+{letter} ({name})"
+        out[f"-{letter}"] = f"−{letter}"
+    return out
+
+
 def unit_globe():
     """A cartopy Globe that is the unit sphere."""
     import cartopy.crs as ccrs
@@ -67,9 +134,10 @@ def unit_globe():
 def laea(centre=(0.0, 0.0, 1.0), *, nose_up: bool | None = None):
     """LAEA projection centred on the direction ``centre`` (unit sphere).
 
-    For a map centred on +z (a tilt map seen from above the head) ``nose_up`` (default
-    True there) rotates it so that +x (nose) points up and +y (left) points left, as
-    when looking down on the animal; other centres keep +z (north) up.
+    For a map centred on +z (a tilt map seen from above) ``nose_up`` (default True
+    there) rotates it so that +x points up and +y left, as when looking down on an
+    animal whose x axis is forward (the nose of a rat head); other centres keep +z
+    (north) up.
     """
     import cartopy.crs as ccrs
 
@@ -85,7 +153,7 @@ def laea(centre=(0.0, 0.0, 1.0), *, nose_up: bool | None = None):
 
 
 def tilt_projection():
-    """The projection of a head-tilt map: centred on the dorsal axis +z, nose up, left ear left."""
+    """The projection of a tilt map: centred on +z, +x up, +y left (seen from above)."""
     return laea((0.0, 0.0, 1.0))
 
 
@@ -229,6 +297,7 @@ def decorate(
     ax,
     *,
     labels: dict | None = None,
+    axis_labels: Any = None,
     equator: bool = True,
     grid_step_deg: float = 30.0,
     gridline_kw: dict | None = None,
@@ -236,9 +305,12 @@ def decorate(
 ):
     """Gridlines (meridians and parallels every ``grid_step_deg``), the equator and labelled sensor axes.
 
-    ``labels`` maps an axis name of ``SENSOR_AXES`` (``"+x"``, ``"-y"``...) to its text;
-    default: ``+x nose, +y left, -x, -y, +z``. Axes within 30° of the map's antipode, or
-    outside the axes' extent, are not labelled.
+    ``labels`` maps an axis name of ``SENSOR_AXES`` (``"+x"``, ``"-y"``...) to its text
+    (``{}``: no labels). By default the texts are :func:`axis_texts` of
+    ``axis_labels``: data whose ``attrs["axis_labels"]`` say what the axes point to (a
+    Recording, a tilt series or map), or the three names; ``None`` gives plain
+    ``+x``, ``+y``, ``+z``. Axes within 30° of the map's antipode, or outside the axes'
+    extent, are not labelled.
     """
     import cartopy.crs as ccrs
 
@@ -263,18 +335,7 @@ def decorate(
             ls="--",
             antipode_deg=1.0,
         )
-    labels = (
-        {
-            "+x": "+x (nose)",
-            "+y": "+y (left)",
-            "-x": "−x",
-            "-y": "−y",
-            "+z": "+z",
-            "-z": "−z",
-        }
-        if labels is None
-        else labels
-    )
+    labels = axis_texts(axis_labels) if labels is None else labels
     for key, text in labels.items():
         v = np.asarray(SENSOR_AXES[key], float)
         if not _far_from_antipode(ax.projection, v[None], 30.0)[0]:

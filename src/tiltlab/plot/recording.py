@@ -14,6 +14,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 import xarray as xr
 
+from .. import axes as _axes
 from ._common import (
     AXIS_COLOURS,
     label,
@@ -113,13 +114,15 @@ def plot_vectors(
     time : array_like, shape (N,)
     values : array_like, shape (N, k)
     labels : sequence of str
-        Component names (legend entries; ``x``, ``y``, ``z``, ``w`` get fixed colours).
+        Component names (legend entries; ``x``, ``y``, ``z``, ``w`` get fixed colours,
+        also when followed by a description, as in ``"x (forward)"``).
     ylabel : str
     lw : float
     """
     values = np.asarray(values)
     for k, lab in enumerate(labels):
-        ax.plot(time, values[:, k], lw=lw, color=_AXIS_COLOURS.get(lab), label=lab)
+        colour = _AXIS_COLOURS.get(str(lab).split(" ")[0])
+        ax.plot(time, values[:, k], lw=lw, color=colour, label=lab)
     ax.set_ylabel(ylabel)
 
 
@@ -135,6 +138,9 @@ def plot_recording(
     figsize: tuple[float, float] | None = None,
 ):
     """One panel per variable of a Recording against time, labelled with its units.
+
+    Vector components are named from the Recording's ``attrs["axis_labels"]`` when it
+    has them (``"x (forward)"``), else ``x``, ``y``, ``z``.
 
     Parameters
     ----------
@@ -178,6 +184,9 @@ def plot_recording(
     for ax, v in zip(axes[:, 0], variables):
         da = sel[v]
         comp = [str(c) for c in da[da.dims[1]].values]
+        if da.dims[1] == "axis" and len(comp) == 3:
+            names = _axes.axis_labels(rec)
+            comp = [c if n == c else f"{c} ({n})" for c, n in zip(comp, names)]
         plot_vectors(
             ax, t, da.values, labels=comp, ylabel=label(v, da.attrs.get("units", ""))
         )

@@ -586,6 +586,7 @@ def recording_from_motion(
         attrs=a,
         mag_units="uT",
         temp_units="degC",
+        axis_labels=["forward (nose)", "left", "up (dorsal)"],
     )
 
 

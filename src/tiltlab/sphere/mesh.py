@@ -56,6 +56,7 @@ error; so is a missing ``fs`` where a function needs durations.
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass, replace
 from functools import lru_cache
 
@@ -613,7 +614,11 @@ def tilt_map(
     xarray.Dataset
         dims ``facet`` (and ``axis`` for ``centroid``): ``count``, ``fraction`` (of the
         kept samples), ``density`` = fraction / area (sr⁻¹; integrates to 1), ``time``
-        (s, if the sampling rate is known), coords ``area`` (sr) and ``centroid``.
+        (s, if the sampling rate is known), coords ``area`` (sr) and ``centroid``; attrs
+        ``n_samples``, ``n_vertices`` and, copied from labelled input, ``method`` and
+        ``axis_labels``. With no valid sample (everything masked out or NaN) the map
+        is empty rather than an error: ``count`` 0, ``fraction`` and ``density`` NaN,
+        ``attrs["empty_reason"]`` saying why, and a :class:`RuntimeWarning`.
     """
     mesh = _check_mesh(mesh)
     sig = _read(vectors, fs=fs, need_fs=False, check_time=True, allow_nan=True)
@@ -633,9 +638,21 @@ def tilt_map(
         x = x[mask]
     counts = _bincount(_locate(_no_zero_rows(x, "vectors"), mesh), mesh, None)
     total = counts.sum()
+    reason = None
     if total == 0:
-        raise ValueError("no valid samples to map")
-    frac = counts / total
+        n_all = sig.values.shape[0]
+        reason = (
+            f"no valid samples to map: {n_all} samples"
+            + (f", {x.shape[0]} kept by the mask" if mask is not None else "")
+            + ", none finite"
+        )
+        warnings.warn(
+            f"tilt_map: {reason}; the map is empty (count 0, fraction and density NaN)",
+            RuntimeWarning,
+            stacklevel=2,
+        )
+    with np.errstate(invalid="ignore", divide="ignore"):
+        frac = counts / total if total else np.full(counts.shape, np.nan)
     ds = xr.Dataset(
         {
             "count": ("facet", counts, {"units": "1", "long_name": "samples"}),
@@ -653,11 +670,14 @@ def tilt_map(
         },
         attrs={"n_samples": int(total), "n_vertices": mesh.n_vertices},
     )
+    if reason is not None:
+        ds.attrs["empty_reason"] = reason
     if sig.fs is not None:
         ds["time"] = ("facet", counts / sig.fs, {"units": "s", "long_name": "time"})
         ds.attrs["fs"] = sig.fs
-    if "method" in sig.attrs:
-        ds.attrs["method"] = sig.attrs["method"]
+    for key in ("method", "axis_labels"):
+        if key in sig.attrs:
+            ds.attrs[key] = sig.attrs[key]
     return ds
 
 
@@ -680,9 +700,12 @@ def visited_fraction(
 
     ``by="area"`` sums the exact facet areas over :math:`4\pi`; ``by="count"`` is the
     fraction of facets (Fayat et al.'s measure, which weights every facet equally even
-    though their areas differ by :meth:`SphereMesh.area_ratio`).
+    though their areas differ by :meth:`SphereMesh.area_ratio`). An empty map (from
+    :func:`tilt_map` with no valid sample) gives NaN: nothing was observed.
     """
     mesh = _check_mesh(mesh)
+    if isinstance(tmap, xr.Dataset) and tmap.attrs.get("n_samples", 1) == 0:
+        return float("nan")
     v = visited(tmap, min_count=min_count)
     if v.shape != (mesh.n_faces,):
         raise ValueError(f"map has {v.shape[0]} facets, mesh has {mesh.n_faces}")

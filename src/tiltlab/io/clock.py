@@ -1,0 +1,401 @@
+"""Clocks of real files: time units, epoch times, sampling-rate estimates, and putting
+samples on a uniform grid (exactly, or by linear interpolation).
+
+Used by :func:`tiltlab.io.read_csv` and :func:`tiltlab.io.read_multi`. A logger's time
+column is rarely a perfect ``k / fs`` grid: boards deliver samples in bursts, crystals
+drift by a percent, and loggers drop samples. Two policies exist:
+
+``"grid"``
+    the samples must already sit on a ``k / fs`` grid; missing ones are gaps (refused,
+    or NaN rows with ``gaps="nan"``).
+``"resample"``
+    every variable is interpolated linearly onto a uniform grid at ``fs``; steps longer
+    than ``max_gap`` sample periods are real gaps and are never interpolated across.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from .. import _validate
+from .. import quality as _quality
+from .. import schema
+
+#: Units accepted for a time column, as factors to seconds.
+TIME_UNITS: dict[str, float] = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "ns": 1e-9}
+_TIME_ALIASES = {
+    "s": "s",
+    "sec": "s",
+    "ms": "ms",
+    "us": "us",
+    "µs": "us",
+    "μs": "us",
+    "ns": "ns",
+}
+_TIME_NAMES = {
+    "s": "seconds",
+    "ms": "milliseconds",
+    "us": "microseconds",
+    "ns": "nanoseconds",
+}
+#: The ``time_units`` value for a column of date-time strings.
+DATETIME = "datetime"
+
+#: Clock policies (see the module docstring).
+CLOCK_POLICIES: tuple[str, ...] = ("grid", "resample")
+
+#: What to do with samples missing from the time column: refuse the file, or put NaN
+#: rows in their place.
+GAP_POLICIES: tuple[str, ...] = ("raise", "nan")
+
+#: Default longest step (in sample periods) that ``clock="resample"`` interpolates
+#: across; a longer one is a real gap.
+MAX_GAP: float = 5.0
+
+#: A time column whose first sample lies between these many seconds after 1970-01-01
+#: (1980 to 2100) holds epoch times.
+_EPOCH_RANGE = (10 * 365.25 * 86400, 130 * 365.25 * 86400)
+
+
+def option_hint(key: str, value: Any, style: str) -> str:
+    """An option as the user writes it: ``"clock": "resample"`` in a mapping (JSON),
+    ``clock='resample'`` as a keyword."""
+    if style == "mapping":
+        return f"{json.dumps(key)}: {json.dumps(value)}"
+    return f"{key}={value!r}"
+
+
+def time_factor(time_units: str, where: str = "") -> float:
+    """Factor from a time unit (``"s"``, ``"ms"``, ``"us"``, ``"ns"``) to seconds."""
+    key = _TIME_ALIASES.get(str(time_units).strip())
+    if key is None:
+        raise ValueError(
+            f"{where}time_units must be one of 's', 'ms', 'us', 'ns' or 'datetime', "
+            f"got {time_units!r}"
+        )
+    return TIME_UNITS[key]
+
+
+def unit_name(scale: float) -> str:
+    """The name of the time unit with factor ``scale`` to seconds, for messages."""
+    return next(
+        (u for u, f in TIME_UNITS.items() if np.isclose(f, scale)), f"× {scale:g} s"
+    )
+
+
+def unit_hint(
+    raw_step: float,
+    fs_range: tuple[float, float] | None,
+    scale: float | None = None,
+    style: str = "python",
+) -> str:
+    """Which time unit (other than the one in use, factor ``scale`` to seconds) would
+    make ``raw_step`` (in the column's numbers) a plausible sampling interval."""
+    from .mapping import FS_RANGE
+
+    lo, hi = fs_range or FS_RANGE
+    for unit, factor in TIME_UNITS.items():
+        if scale is not None and np.isclose(factor, scale):
+            continue
+        f = 1.0 / (raw_step * factor)
+        if lo <= f <= hi:
+            return (
+                f"; the time column looks like {_TIME_NAMES[unit]}: give "
+                f"{option_hint('time_units', unit, style)} (fs would be {f:.6g} Hz)"
+            )
+    return ""
+
+
+def to_seconds(
+    raw: np.ndarray, time_units: str | float, where: str = ""
+) -> tuple[np.ndarray, np.datetime64 | None]:
+    """A time column as seconds.
+
+    Parameters
+    ----------
+    raw : numpy.ndarray, shape (N,)
+        The column as read: numbers (integers are kept exact until the first sample is
+        subtracted) or, for ``time_units="datetime"``, date-time strings.
+    time_units : str or float
+        ``"datetime"``, or the factor from the column's numbers to seconds.
+    where : str
+        Prefix for messages.
+
+    Returns
+    -------
+    seconds : numpy.ndarray
+        Times in seconds. Epoch times (the first sample between 1980 and 2100 when read
+        in the given unit) and date-times are returned relative to the first sample.
+    origin : numpy.datetime64 or None
+        The absolute time of the first sample (UTC, ns) for epoch and date-time
+        columns, else None.
+    """
+    if isinstance(time_units, str) and time_units == DATETIME:
+        import pandas as pd
+
+        try:
+            try:  # one ISO 8601 layout (fractions of a second may come and go) …
+                stamps = pd.to_datetime(pd.Series(raw), utc=True, format="ISO8601")
+            except (ValueError, TypeError):  # … or any layout pandas recognises
+                stamps = pd.to_datetime(pd.Series(raw), utc=True, format="mixed")
+        except (ValueError, TypeError) as exc:
+            raise schema.RecordingError(
+                f"{where}time column is not date-time text ({exc}); give time_units "
+                "'s', 'ms', 'us' or 'ns' for a numeric column"
+            ) from None
+        if stamps.isna().any():
+            i = int(np.argmax(stamps.isna().to_numpy()))
+            raise schema.RecordingError(
+                f"{where}time column has an empty or unreadable date-time at data row {i}"
+            )
+        ns = stamps.dt.tz_localize(None).to_numpy().astype("datetime64[ns]")
+        origin = ns[0]
+        return (ns - origin).astype(np.int64) * 1e-9, origin
+    factor = float(time_units)
+    values = np.asarray(raw)
+    if values.size == 0:
+        return values.astype(float), None
+    first = float(values[0]) * factor
+    if not _EPOCH_RANGE[0] <= first <= _EPOCH_RANGE[1]:
+        return values.astype(float) * factor, None
+    # epoch times: subtract the first sample before the float conversion
+    if np.issubdtype(values.dtype, np.integer):
+        rel = (values.astype(np.int64) - np.int64(values[0])).astype(float) * factor
+        ns_per_unit = factor * 1e9
+        if ns_per_unit >= 1:
+            origin_ns = int(values[0]) * int(round(ns_per_unit))
+        else:
+            origin_ns = int(values[0]) // int(round(1 / ns_per_unit))
+    else:
+        from decimal import Decimal
+
+        v = values.astype(float)
+        rel = (v - v[0]) * factor
+        # the decimal number as written, to the nanosecond (no float rounding)
+        exact = Decimal(repr(float(v[0]))) * Decimal(repr(factor)) * 1_000_000_000
+        origin_ns = int(exact.to_integral_value())
+    return rel, np.datetime64(origin_ns, "ns")
+
+
+def iso_utc(origin: np.datetime64) -> str:
+    """An ISO-8601 UTC string for an absolute time."""
+    import pandas as pd
+
+    return pd.Timestamp(origin).tz_localize("UTC").isoformat()
+
+
+def check_increasing(time: np.ndarray, column: str, where: str) -> None:
+    """Refuse non-finite or non-increasing sample times, naming the data row."""
+    if not np.all(np.isfinite(time)):
+        i = int(np.argmax(~np.isfinite(time)))
+        raise schema.RecordingError(
+            f"{where}time column {column!r} has non-finite values (data row {i})"
+        )
+    step = np.diff(time)
+    if np.any(step <= 0):
+        i = int(np.argmax(step <= 0))
+        raise schema.RecordingError(
+            f"{where}time column {column!r} is not strictly increasing "
+            f"(data row {i + 1}: {time[i + 1]!r} after {time[i]!r})"
+        )
+
+
+def gap_steps(time: np.ndarray, fs: float, max_gap: float) -> np.ndarray:
+    """Indices ``i`` of the steps ``time[i] → time[i+1]`` longer than ``max_gap / fs``."""
+    return np.flatnonzero(np.diff(time) > max_gap / fs)
+
+
+def estimate_rate(time: np.ndarray, max_gap: float = MAX_GAP) -> tuple[float, int]:
+    """A robust sampling rate of an irregular clock: (samples − 1) / duration, leaving
+    out the real gaps (steps longer than ``max_gap`` periods) and the samples missing
+    in them.
+
+    The mean rate, unlike 1 / median step, is right for bursty clocks (many short steps
+    and a few long ones) and for clocks that alternate between two step lengths.
+
+    Returns
+    -------
+    fs : float
+        Hz.
+    n_gaps : int
+        Number of steps left out as gaps.
+    """
+    t = np.asarray(time, dtype=float)
+    steps = np.diff(t)
+    fs = (t.size - 1) / (t[-1] - t[0])
+    gaps = np.zeros(steps.size, dtype=bool)
+    for _ in range(10):  # converges in a few rounds: gaps shorten the duration
+        new = steps > max_gap / fs
+        if new.all():
+            break
+        fs = (t.size - 1 - new.sum()) / steps[~new].sum()
+        if np.array_equal(new, gaps):
+            break
+        gaps = new
+    return float(fs), int(gaps.sum())
+
+
+def _gap_list(time: np.ndarray, idx: np.ndarray, max_items: int = 5) -> str:
+    items = [
+        f"{time[i + 1] - time[i]:.3g} s after t = {time[i]:.6g} s (data row {i})"
+        for i in idx[:max_items]
+    ]
+    more = f" and {idx.size - max_items} more" if idx.size > max_items else ""
+    n = idx.size
+    return f"{n} gap{'s' if n != 1 else ''}: " + ", ".join(items) + more
+
+
+def raise_gaps(
+    time: np.ndarray,
+    idx: np.ndarray,
+    fs: float,
+    max_gap: float,
+    column: str,
+    where: str,
+    style: str,
+) -> None:
+    """The error for real gaps in a clock read with ``clock="resample"``."""
+    raise schema.RecordingError(
+        f"{where}time column {column!r} has steps longer than max_gap = {max_gap:g} "
+        f"sample periods ({max_gap / fs:.3g} s at {fs:.6g} Hz), which are not "
+        f"interpolated across ({_gap_list(time, idx)}). Read with "
+        f"{option_hint('gaps', 'nan', style)} to keep them as NaN on the grid, or, if the "
+        "samples only arrive in bursts, give a larger max_gap (e.g. "
+        f"{option_hint('max_gap', float(np.ceil(2 * max_gap)), style)})"
+    )
+
+
+def uniform_grid(start: float, stop: float, fs: float) -> np.ndarray:
+    """``start + k / fs`` for every k with the time inside ``[start, stop]``."""
+    n = int(np.floor((stop - start) * fs * (1 + 1e-12) + 1e-9)) + 1
+    return start + np.arange(max(n, 0)) / fs
+
+
+def interpolate(
+    time: np.ndarray,
+    values: np.ndarray,
+    grid: np.ndarray,
+    gap_idx: np.ndarray | None = None,
+    *,
+    quaternion: bool = False,
+) -> np.ndarray:
+    """Linear interpolation of samples at ``time`` onto ``grid`` (inside the samples'
+    span), NaN inside the steps listed in ``gap_idx``.
+
+    Each grid value is the straight line between the two samples around it. Linear
+    interpolation never overshoots and keeps a still sensor still, but it is a mild
+    low-pass filter: a sine at frequency f sampled every T loses up to
+    ``1 - sinc²(f T)`` of its amplitude between samples, and nothing is done against
+    aliasing when the grid is coarser than the samples. ``quaternion=True`` keeps the
+    quaternions in one hemisphere before interpolating and normalises the result.
+    """
+    v = np.asarray(values, dtype=float)
+    v2 = v.reshape(v.shape[0], -1)
+    if quaternion:
+        v2 = v2.copy()
+        flip = np.cumprod(
+            np.r_[1.0, np.sign(np.sum(v2[1:] * v2[:-1], axis=1) + 1e-300)]
+        )
+        v2 *= flip[:, None]
+    i = np.clip(np.searchsorted(time, grid, side="right") - 1, 0, time.size - 2)
+    w = (grid - time[i]) / (time[i + 1] - time[i])
+    out = v2[i] + w[:, None] * (v2[i + 1] - v2[i])
+    exact = grid == time[i + 1]  # the last sample itself
+    out[exact] = v2[i[exact] + 1]
+    if gap_idx is not None and gap_idx.size:
+        is_gap = np.zeros(time.size - 1, dtype=bool)
+        is_gap[gap_idx] = True
+        inside = is_gap[i] & (grid > time[i]) & (grid < time[i + 1])
+        out[inside] = np.nan
+    if quaternion:
+        out /= np.linalg.norm(out, axis=1, keepdims=True)
+    return out.reshape((grid.size, *v.shape[1:]))
+
+
+def describe_resampling(time: np.ndarray, n_out: int, fs: float) -> str:
+    """A sentence for ``attrs['resampled']``."""
+    steps = np.diff(time)
+    return (
+        f"{time.size} samples with irregular steps (median {np.median(steps) * 1e3:.4g} "
+        f"ms, max {steps.max() * 1e3:.4g} ms) interpolated linearly onto {n_out} "
+        f"samples at {fs:.7g} Hz"
+    )
+
+
+def warn_if_downsampled(fs: float, fs_source: float, what: str) -> None:
+    """Linear interpolation onto a coarser grid does not remove what it cannot hold."""
+    if fs < 0.9 * fs_source:
+        import warnings
+
+        warnings.warn(
+            f"{what}: the samples come at about {fs_source:.4g} Hz and are interpolated "
+            f"onto {fs:.4g} Hz; linear interpolation does not low-pass filter, so "
+            f"content above {fs / 2:.4g} Hz aliases. Low-pass filter first, or keep the "
+            "native rate",
+            _quality.QualityWarning,
+            stacklevel=3,
+        )
+
+
+def place_on_grid(
+    time: np.ndarray,
+    get: dict[str, np.ndarray],
+    fs: float,
+    column: str,
+    where: str,
+    gaps: str,
+    style: str,
+) -> tuple[np.ndarray, dict[str, np.ndarray], int]:
+    """``clock="grid"``: find samples missing from a time column (steps of about k/fs,
+    k ≥ 2), refuse them (``gaps="raise"``) or insert NaN rows in their place
+    (``"nan"``); return the time, the columns and the number of samples inserted.
+
+    A clock that is not on a ``k / fs`` grid (jitter, drift) is refused with a hint to
+    read it with ``clock="resample"``.
+    """
+    segs = _validate.segments(time, fs)
+    if len(segs) <= 1:
+        return time, get, 0
+    pos = (time - time[0]) * fs
+    k = np.rint(pos).astype(np.int64)
+    off = (np.abs(pos - k) > 0.35) | np.r_[False, np.diff(k) < 1]
+    if np.any(off):
+        i = int(np.argmax(off))
+        steps = np.diff(time) * fs
+        raise schema.RecordingError(
+            f"{where}time column {column!r} is not on a regular grid of 1/fs = "
+            f"{1 / fs:.6g} s (data row {i}: {pos[i]:.2f} sample periods after the "
+            f"first; steps range from {steps.min():.3g} to {steps.max():.3g} periods): "
+            "the clock jitters or drifts, or fs is wrong. Read with "
+            f"{option_hint('clock', 'resample', style)} to interpolate every variable "
+            "onto a uniform grid"
+        )
+    n_missing = int(k[-1] + 1 - k.size)
+    if gaps == "raise":
+        raise schema.RecordingError(
+            f"{where}time column {column!r} skips samples "
+            f"({_validate.describe_gaps(time, fs, segs)}"
+            + (f"; about {n_missing} samples missing" if n_missing > 0 else "")
+            + "): the logger dropped samples, or fs is wrong. "
+            f"Read with {option_hint('gaps', 'nan', style)} to keep the gaps as NaN rows "
+            "(orientation filters then run on each gap-free segment, "
+            "estimate(..., gaps='segments'))"
+        )
+    n = int(k[-1] + 1)
+    full_time = time[0] + np.arange(n) / fs
+    full_time[k] = time
+    out = {}
+    for var, v in get.items():
+        filled = np.full((n, *v.shape[1:]), np.nan)
+        filled[k] = v
+        out[var] = filled
+    return full_time, out, n - k.size
+
+
+def source_name(path: Path, variable: str | None = None) -> str:
+    """A file name (and variable) for attrs."""
+    return path.name + (f":{variable}" if variable else "")
