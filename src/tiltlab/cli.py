@@ -40,7 +40,7 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
-__all__ = ["main"]
+__all__ = ["main", "run"]
 
 #: Exit statuses.
 EXIT_OK, EXIT_ERROR, EXIT_REJECTED = 0, 1, 2
@@ -770,3 +770,34 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 if __name__ == "__main__":  # pragma: no cover
     sys.exit(main())
+
+
+def run(command: str) -> int:
+    """Run one ``tiltlab`` command line from Python (a notebook), as a shell would.
+
+    The line is echoed as ``$ tiltlab ...``; what the command writes to stderr (its
+    one-line errors and ``warning:`` lines) is shown with its output.
+
+    Parameters
+    ----------
+    command : str
+        The arguments, e.g. ``"convert tag.csv --mapping tag.json --out tag.nc"``.
+
+    Returns
+    -------
+    int
+        The exit status (see :func:`main`).
+
+    Examples
+    --------
+    >>> from tiltlab import cli
+    >>> cli.run("info broad:2 --help")  # doctest: +SKIP
+    """
+    import shlex
+
+    print(f"$ tiltlab {command}")
+    with contextlib.redirect_stderr(sys.stdout):
+        status = main(shlex.split(command))
+    if status:
+        print(f"(exit status {status})")
+    return status

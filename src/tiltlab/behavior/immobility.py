@@ -186,9 +186,17 @@ def acc_immobility(
     """
     thr = _v.positive(threshold_g, "threshold_g")
     smooth_s = _v.nonnegative(smooth_s, "smooth_s")
-    s = read(acc, "acc", fs=fs, units=units, to_units="g", need_fs=True)
+    s = read(acc, "acc", fs=fs, units=units, to_units="g", need_fs=True, allow_nan=True)
     a = s.values
+    ok = np.isfinite(a).all(axis=1)
+    if not ok.any():
+        raise _v.RecordingError("acc has no finite sample: immobility is undefined")
+    if not ok.all():  # missing samples (gaps kept as NaN): bridged for the running
+        # mean, and never counted as immobile themselves
+        idx = np.arange(a.shape[0])
+        a = np.column_stack([np.interp(idx, idx[ok], a[ok, k]) for k in range(3)])
     d = np.linalg.norm(a - _sliding_mean(a, window_samples(window_s, s.fs)), axis=1)
+    d[~ok] = 1e3 * thr  # far above the threshold: a missing sample is never still
     mask = still_mask(
         d,
         s.fs,

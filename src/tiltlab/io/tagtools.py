@@ -387,6 +387,10 @@ def read_tagtools(
             extra=extra or None,
             attrs={**meta, **attrs},
             check_units=check_units,
+            # missing samples (NaN) are kept as gaps, as read_csv(gaps="nan") does
+            allow_nan=any(
+                bool(np.isnan(v).any()) for v in data.values() if v.dtype.kind == "f"
+            ),
             **axis_kw,
         )
     except ValueError as exc:
