@@ -68,7 +68,7 @@ def main(argv: list[str]) -> int:
                 continue
             for label, how, check in _jobs(stem, module):
                 ran += 1
-                work = Path(tmp) / label.replace(" ", "_").strip("[]")
+                work = Path(tmp) / label.replace(" [", "_").replace("]", "")
                 work.mkdir(parents=True, exist_ok=True)
                 out = work / f"{stem}.rerun.ipynb"
                 t0 = time.perf_counter()

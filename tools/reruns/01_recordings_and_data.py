@@ -6,6 +6,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from ._common import printed
+from ._foreign import convert
 
 
 def prepare(tmp: Path) -> dict:
@@ -53,3 +54,32 @@ def check(nb_path: Path, params: dict) -> str:
     return (
         f"median angle a/|a| vs g_s while still {got:.2f}° (package: {expected:.2f}°)"
     )
+
+
+def prepare_foreign(tmp: Path) -> dict:
+    """A hand-held board from another lab (one MATLAB file per sensor, bursty clocks),
+    converted by ``tiltlab convert``; the second recording a foot IMU's two-row CSV."""
+    return {
+        "SOURCE": str(convert("board", tmp)),
+        "MAT_SOURCE": str(convert("foot", tmp)),
+        "WINDOW": [0.0, 30.0],
+        "STILL_DEG_S": 8.0,
+        "COHORT_TRIALS": [5],
+        "CSV_DURATION_S": 40.0,
+        "CSV_FS": 200.0,
+    }
+
+
+def check_foreign(nb_path: Path, params: dict) -> str:
+    """The sample count and rate the chapter prints are those of the converted file."""
+    from tiltlab import datasets
+
+    rec = datasets.load(params["SOURCE"])
+    found = printed(nb_path, r": (\d+) samples, [0-9.]+ s at ([0-9.]+) Hz", "summary")
+    n, fs = int(found[0][0]), float(found[0][1])
+    if n != rec.sizes["time"] or abs(fs - float(rec.attrs["fs"])) > 0.01:
+        raise AssertionError(f"chapter says {n} samples at {fs} Hz, the file differs")
+    return f"converted board: {n} samples at {fs:g} Hz"
+
+
+VARIANTS = {"foreign": prepare_foreign}

@@ -6,6 +6,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from ._common import printed
+from ._foreign import convert
 
 PARAMS = {
     "SOURCE": "broad:2",
@@ -34,3 +35,13 @@ def check(nb_path: Path, params: dict) -> str:
             f"chapter says {got:.1%} immobile, behavior.immobility gives {expected:.1%}"
         )
     return f"immobile fraction {got:.1%} (package: {expected:.1%})"
+
+
+def prepare_foreign(tmp: Path) -> dict:
+    """A hand-held board from another lab, converted by ``tiltlab convert``."""
+    board = str(convert("board", tmp))
+    return {**PARAMS, "SOURCE": board, "HEADING_SOURCE": board, "N_BOOT": 100}
+
+
+check_foreign = check
+VARIANTS = {"foreign": prepare_foreign}
