@@ -261,7 +261,7 @@ def _cmd_info(args: argparse.Namespace) -> int:
     if what is not None:
         print(f"{'file':>14}: {what}")
     for k, v in schema.describe(rec).items():
-        print(f"{k:>14}: {v:.7g}" if isinstance(v, float) else f"{k:>14}: {v}")
+        print(f"{k:>14}: {float(f'{v:.7g}') if isinstance(v, float) else v}")
     if "fs_source" in rec.attrs:
         print(f"{'fs_source':>14}: {rec.attrs['fs_source']}")
     if what is not None and not what.startswith("tiltlab Recording"):
