@@ -14,7 +14,8 @@ silently analyse the wrong thing. Every chapter must have a rerun module. A modu
 also define ``VARIANTS``: a dict of further reruns, name → ``prepare`` function (with an
 optional ``check_<name>``), e.g. the chapter on a converted recording from another lab.
 
-Usage: ``python tools/rerun_chapters.py [NOTEBOOK_STEM ...]``
+Usage: ``python tools/rerun_chapters.py [NOTEBOOK_STEM[:VARIANT] ...]`` (``main`` names
+the module's main rerun).
 """
 
 from __future__ import annotations
@@ -64,9 +65,16 @@ def main(argv: list[str]) -> int:
     failures = ran = 0
     with tempfile.TemporaryDirectory() as tmp:
         for stem, module in reruns():
-            if wanted and stem not in wanted:
+            if (
+                wanted
+                and stem not in wanted
+                and not any(w.startswith(f"{stem}:") for w in wanted)
+            ):
                 continue
             for label, how, check in _jobs(stem, module):
+                name = label.partition(" [")[2].rstrip("]") or "main"
+                if wanted and stem not in wanted and f"{stem}:{name}" not in wanted:
+                    continue
                 ran += 1
                 work = Path(tmp) / label.replace(" [", "_").replace("]", "")
                 work.mkdir(parents=True, exist_ok=True)

@@ -79,7 +79,18 @@ def check_foreign(nb_path: Path, params: dict) -> str:
     n, fs = int(found[0][0]), float(found[0][1])
     if n != rec.sizes["time"] or abs(fs - float(rec.attrs["fs"])) > 0.01:
         raise AssertionError(f"chapter says {n} samples at {fs} Hz, the file differs")
-    return f"converted board: {n} samples at {fs:g} Hz"
+    return f"converted file: {n} samples at {fs:g} Hz"
 
 
 VARIANTS = {"foreign": prepare_foreign}
+
+
+def prepare_tag(tmp: Path) -> dict:
+    """An accelerometer + magnetometer tag from another lab (no gyroscope, raw counts
+    scaled by the mapping, a jittery millisecond clock), converted by ``tiltlab convert``:
+    the chapter's gyroscope sections say they are skipped."""
+    return {**prepare_foreign(tmp), "SOURCE": str(convert("tag", tmp))}
+
+
+check_tag = check_foreign
+VARIANTS["tag"] = prepare_tag

@@ -10,6 +10,8 @@
   (:func:`mocap_markers`, :func:`simulate_mocap_session`);
 * :mod:`~tiltlab.simulate.cohort` — lesion cohorts on disk
   (:func:`simulate_cohort`, :func:`load_cohort`);
+* :mod:`~tiltlab.simulate.export` — a Recording written as a phone logger's export, one
+  CSV per sensor on its own jittery clock (:func:`phone_export`);
 * :mod:`~tiltlab.simulate.track` — bio-logging demonstrations: 3-D tracks for dead
   reckoning and flapping/gliding heave (:func:`simulate_track`, :func:`simulate_heave`).
 
@@ -42,6 +44,7 @@ from .sensor import (
     true_sensor_values,
 )
 from .tumble import stage_angles, stage_quaternion, tumble_test, zoh_angular_velocity
+from .export import PHONE_FILES, phone_export
 from .mocap import (
     MarkerSupport,
     head_frame_from_markers,
@@ -84,6 +87,8 @@ __all__ = [
     "stage_quaternion",
     "tumble_test",
     "zoh_angular_velocity",
+    "PHONE_FILES",
+    "phone_export",
     "MarkerSupport",
     "head_frame_from_markers",
     "mocap_markers",
