@@ -416,3 +416,22 @@ def test_activity_keeps_labels_and_units():
     p = B.step_summary(rec["acc"].values, 100.0, window_s=1.0)
     np.testing.assert_allclose(s.time, p.time + float(rec.time[0]))
     np.testing.assert_array_equal(s.dba.values, p.dba)
+
+
+def test_dba_nan_only_where_the_window_touches_a_gap():
+    """A gap (NaN samples) makes DBA NaN within half a window of it; elsewhere the
+    values equal those of the same recording without the gap."""
+    from tiltlab import behavior
+
+    rng = np.random.default_rng(4)
+    fs, k = 100.0, 50  # window 0.5 s = 50 samples
+    a = np.c_[rng.normal(0, 0.1, (2000, 2)), 1 + rng.normal(0, 0.1, 2000)]
+    gappy = a.copy()
+    gappy[1000:1010] = np.nan
+    full = behavior.dba(a, fs, window_s=0.5)
+    cut = behavior.dba(gappy, fs, window_s=0.5)
+    near = np.zeros(2000, bool)
+    near[1000 - (k - 1 - k // 2) : 1010 + k // 2] = True
+    assert np.isnan(cut[near]).all()
+    np.testing.assert_allclose(cut[~near], full[~near], rtol=1e-12)
+    assert np.isfinite(behavior.odba(gappy, fs, window_s=0.5)[~near]).all()

@@ -49,19 +49,25 @@ def window_length(window_s: float, fs: float) -> int:
 
 
 def _read_acc(acc, fs):
-    return read(acc, "acc", fs=fs, need_fs=True)
+    # NaN marks a gap of a recording read with gaps="nan"; windows touching it are NaN
+    return read(acc, "acc", fs=fs, need_fs=True, allow_nan=True)
 
 
 def _sliding_mean(a: np.ndarray, k: int) -> np.ndarray:
-    """Centred window of k samples, truncated at the ends (no NaN)."""
+    """Centred window of k samples, truncated at the ends; NaN where the window holds
+    a non-finite sample (a gap), finite elsewhere."""
     n = a.shape[0]
     before = k // 2
     after = k - 1 - before
-    c = np.vstack([np.zeros((1, a.shape[1])), np.cumsum(a, axis=0)])
+    bad = ~np.isfinite(a).all(axis=1)
+    c = np.vstack([np.zeros((1, a.shape[1])), np.cumsum(np.where(bad[:, None], 0, a), 0)])
+    cb = np.r_[0, np.cumsum(bad)]
     i = np.arange(n)
     lo = np.maximum(0, i - before)
     hi = np.minimum(n, i + after + 1)
-    return (c[hi] - c[lo]) / (hi - lo)[:, None]
+    out = (c[hi] - c[lo]) / (hi - lo)[:, None]
+    out[(cb[hi] - cb[lo]) > 0] = np.nan
+    return out
 
 
 def static_acceleration(
@@ -75,7 +81,8 @@ def static_acceleration(
 
     ``"sliding"``: centred window of k = round(fΔt) samples attributed to its centre
     ((k−1)/2 samples either side for odd k; k/2 before and (k−2)/2 after for even k);
-    near the ends the window is truncated to the available samples (no NaN). Output
+    near the ends the window is truncated to the available samples (no NaN). A window
+    that holds a non-finite sample (a gap left as NaN by a reader) gives NaN. Output
     shape = input shape (N, 3).
 
     ``"jumping"``: means of consecutive non-overlapping blocks of k samples; a

@@ -371,9 +371,6 @@ def load_session(row: Mapping[str, Any], root) -> xr.Dataset:
         opts = _options(opts, reader, f"session {row.get('session')!r}")
     opts = dict(opts)
     func = READERS[reader]
-    if "check_units" in opts and not _takes(func, "check_units"):
-        # readers of published data sets label their units themselves
-        opts.pop("check_units")
     try:
         rec = func(session_path(row["file"], root), **opts)
     except UnitCheckError as err:

@@ -60,13 +60,14 @@ def _read_broad_mat(path: Path) -> tuple[dict[str, np.ndarray], float, str]:
     return data, fs, info
 
 
-def read_broad(path: PathLike, **attrs) -> xr.Dataset:
+def read_broad(path: PathLike, *, check_units: bool = True, **attrs) -> xr.Dataset:
     """Read a BROAD benchmark trial (``.hdf5`` or ``.mat``) into a Recording.
 
     Units are kept as published: acceleration m/s², angular velocity rad/s,
     magnetic field µT. ``q_ref`` is the optical orientation (w, x, y, z, sensor → ENU,
     already aligned to the IMU frame), ``movement`` the boolean mask of samples to score
-    and ``opt_pos`` the optical position (m).
+    and ``opt_pos`` the optical position (m). ``check_units=False`` skips the unit
+    plausibility check (:func:`tiltlab.schema.make_recording`), as for every reader.
 
     References
     ----------
@@ -103,6 +104,7 @@ def read_broad(path: PathLike, **attrs) -> xr.Dataset:
         mag=data["imu_mag"],
         mag_units="uT",
         q_ref=q,
+        check_units=check_units,
         extra={
             "movement": (
                 "time",

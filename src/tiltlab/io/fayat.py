@@ -12,7 +12,12 @@ from ._common import PathLike, _read_table
 
 
 def read_fayat_imu(
-    path: PathLike, *, counter_rate: float = 300.0, fs: float = 100.0, **attrs
+    path: PathLike,
+    *,
+    counter_rate: float = 300.0,
+    fs: float = 100.0,
+    check_units: bool = True,
+    **attrs,
 ) -> xr.Dataset:
     """Read Fayat et al.'s freely-moving rat example (``example_imu.csv``).
 
@@ -20,7 +25,8 @@ def read_fayat_imu(
     °/s, ``counter`` the acquisition board's sample counter at ``counter_rate`` Hz. The
     file is down-sampled to ``fs`` = 100 Hz, so sample times are ``(counter − counter₀) /
     counter_rate``; 27 of its intervals are 2/300 s instead of 3/300 s (left as they are,
-    and kept in the ``counter`` variable).
+    and kept in the ``counter`` variable). ``check_units=False`` skips the unit
+    plausibility check, as for every reader.
 
     Axes: x points forward (nose), y to the animal's left, z up (dorsal) [1]_.
 
@@ -42,6 +48,7 @@ def read_fayat_imu(
         gyr_units="deg/s",
         preset="rat_head",
         time=time,
+        check_units=check_units,
         extra={
             "counter": (
                 "time",
@@ -60,12 +67,14 @@ def read_fayat_imu(
     )
 
 
-def read_fayat_tumble(path: PathLike, *, fs: float = 300.0, **attrs) -> xr.Dataset:
+def read_fayat_tumble(
+    path: PathLike, *, fs: float = 300.0, check_units: bool = True, **attrs
+) -> xr.Dataset:
     """Read Fayat et al.'s tumble-test recording (``example_sensor_calibration.csv``).
 
     Columns: an unnamed index, ``ax, ay, az`` (g), ``gx, gy, gz`` (°/s), ``time`` (s);
     300 Hz. The sensor is held still in several orientations; there is no trigger
-    channel.
+    channel. ``check_units=False`` skips the unit plausibility check.
 
     The MPU9250 was set to ±4 g and ±1000 °/s: every value is a multiple of 1/8192 g and
     1/32.768 °/s, and the file holds the rails −4 g, 32767/8192 g and −1000 °/s. Both are
@@ -88,6 +97,7 @@ def read_fayat_tumble(path: PathLike, *, fs: float = 300.0, **attrs) -> xr.Datas
         acc_range=4.0,
         gyr_range=1000.0,
         time=df["time"].to_numpy(),
+        check_units=check_units,
         attrs={
             "source": str(Path(path).name),
             "sensor": "MPU9250",
