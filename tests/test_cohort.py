@@ -280,7 +280,7 @@ def test_session_features_do_not_mutate_and_label_everything():
 def test_session_features_refuse_bad_recordings():
     rec = simulate_session(10.0, 100.0, seed=1, keep_true=False)
     bad = rec.copy(deep=True)
-    bad["acc"][5, 0] = np.nan
+    bad["acc"][5, 0] = np.inf  # NaN marks a gap (left out); infinity is an error
     with pytest.raises(ValueError, match="acc"):
         cohort.session_features(bad)
     with pytest.raises(ValueError, match="too short"):

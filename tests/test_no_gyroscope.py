@@ -337,3 +337,62 @@ def test_axis_names_of_plain_data_and_of_labelled_data():
     da.attrs["axis_labels"] = RAT
     assert plot.axis_names(da) == ["nose", "left", "dorsal"]
     assert plot.axis_texts(da)["-y"] == "−y"
+
+
+@pytest.mark.parametrize("drop", [(), ("gyr",)])
+def test_features_leave_out_gaps_and_say_so(drop):
+    """A session with a gap (NaN samples, as read with gaps="nan") gives the features of
+    its samples outside the gap: activity unchanged far from it, the gap counted in
+    attrs, n_samples the samples used; a gap-free session has no 'gaps' attribute."""
+    rec = _session(60.0).drop_vars(list(drop))
+    full = cohort.session_features(rec, CONFIG)
+    assert "gaps" not in full.attrs
+    gappy = rec.copy(deep=True)
+    for v in ("acc", "gyr"):
+        if v in gappy:
+            gappy[v][3000:3050] = np.nan
+    before = gappy.copy(deep=True)
+    cut = cohort.session_features(gappy, CONFIG)
+    assert gappy.identical(before)  # the input is not modified
+    assert cut.attrs["gaps"].startswith("50 of 6000 samples")
+    assert int(cut["n_samples"]) == 5950
+    assert float(cut["duration_s"]) == float(full["duration_s"])
+    for k in ("immobile_fraction", "visited_fraction", "dba_mean", "tilt_immobile_z"):
+        assert np.isfinite(cut[k].values), k
+    assert float(cut["dba_mean"]) == pytest.approx(float(full["dba_mean"]), rel=0.02)
+    assert abs(float(cut["immobile_fraction"] - full["immobile_fraction"])) < 0.02
+
+
+def test_cohort_table_says_why_features_are_nan(tmp_path):
+    """An accelerometer-only session runs in a cohort: status ok, its NaN features
+    explained in the table's ``notes`` and in the summary, grouped by reason."""
+    import pandas as pd
+
+    from tiltlab import io
+
+    rows = []
+    for i, drop in enumerate([[], ["gyr"]]):
+        path = io.save_netcdf(
+            _session(30.0, seed=i).drop_vars(drop), tmp_path / f"s{i}.nc"
+        )
+        rows.append(
+            dict(
+                session=f"s{i}",
+                subject=f"a{i}",
+                group=f"g{i}",
+                timepoint="t0",
+                file=str(path),
+                reader="netcdf",
+                reader_options="{}",
+            )
+        )
+    pd.DataFrame(rows).to_csv(tmp_path / "manifest.csv", index=False)
+    manifest = cohort.read_manifest(tmp_path / "manifest.csv")
+    table = cohort.run_cohort(manifest, CONFIG, progress=False)
+    assert list(table["status"].values) == ["ok", "ok"]
+    notes = table["notes"].values
+    assert notes[0] == ""
+    assert "circling_index" in notes[1] and "gyroscope" in notes[1]
+    assert notes[1].count("needs a gyroscope") <= 2  # grouped by reason
+    text = str(cohort.summary(table))
+    assert "NaN features in s1" in text and "NaN features in s0" not in text

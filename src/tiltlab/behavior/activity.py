@@ -60,7 +60,9 @@ def _sliding_mean(a: np.ndarray, k: int) -> np.ndarray:
     before = k // 2
     after = k - 1 - before
     bad = ~np.isfinite(a).all(axis=1)
-    c = np.vstack([np.zeros((1, a.shape[1])), np.cumsum(np.where(bad[:, None], 0, a), 0)])
+    c = np.vstack(
+        [np.zeros((1, a.shape[1])), np.cumsum(np.where(bad[:, None], 0, a), 0)]
+    )
     cb = np.r_[0, np.cumsum(bad)]
     i = np.arange(n)
     lo = np.maximum(0, i - before)

@@ -117,7 +117,7 @@ def robust_gyro_offset(
     total gyroscope variance is within the lowest ``quantile`` are taken as still, and
     the per-axis median of their samples is returned. Variance does not depend on the
     offset, so this works for offsets of tens of °/s, and it needs only ``quantile`` of
-    the record to be still.
+    the record to be still. Windows holding a non-finite sample (a gap) are left out.
 
     Parameters
     ----------
@@ -136,7 +136,7 @@ def robust_gyro_offset(
     ndarray (3,)
         The offset, in the units of ``gyr``.
     """
-    s = _v.signal(gyr, "gyr", fs=fs)
+    s = _v.signal(gyr, "gyr", fs=fs, allow_nan=True)
     window_s = _v.positive(window_s, "window_s")
     quantile = _v.fraction(quantile, "quantile", open_low=True)
     g = s.values
@@ -148,8 +148,14 @@ def robust_gyro_offset(
             f"window_s = {window_s:g} s: cannot estimate a gyro offset"
         )
     blocks = g[: nw * w].reshape(nw, w, 3)
-    var = blocks.var(axis=1).sum(axis=1)
-    quiet = var <= np.quantile(var, quantile)
+    var = blocks.var(axis=1).sum(axis=1)  # NaN for a window that holds a gap
+    ok = np.isfinite(var)
+    if not ok.any():
+        raise CalibrationError(
+            f"every {window_s:g}-s window of gyr holds a non-finite sample: cannot "
+            "estimate a gyro offset"
+        )
+    quiet = ok & (var <= np.quantile(var[ok], quantile))
     return np.median(blocks[quiet].reshape(-1, 3), axis=0)
 
 

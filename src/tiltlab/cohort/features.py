@@ -53,6 +53,8 @@ References
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 import xarray as xr
 
@@ -81,7 +83,7 @@ def feature_specs(config: FeatureConfig | None = None) -> dict[str, tuple[str, s
     c = config or FeatureConfig()
     thr = f"{c.threshold_deg_s:g} deg/s"
     spec = {
-        "n_samples": ("1", "number of samples analysed"),
+        "n_samples": ("1", "number of samples analysed (samples in gaps left out)"),
         "duration_s": ("s", "duration of the recording"),
         "gyr_offset_x": ("deg/s", "gyroscope offset removed, x (session estimate)"),
         "gyr_offset_y": ("deg/s", "gyroscope offset removed, y (session estimate)"),
@@ -169,7 +171,10 @@ def _dataset(
     }
     if reasons:
         a["reasons"] = reasons
-        a["notes"] = "; ".join(f"{k}: {r}" for k, r in reasons.items())
+        by_reason: dict[str, list[str]] = {}
+        for k, r in reasons.items():
+            by_reason.setdefault(r, []).append(k)
+        a["notes"] = "; ".join(f"{', '.join(ks)}: {r}" for r, ks in by_reason.items())
     return xr.Dataset(data, attrs=a)
 
 
@@ -265,7 +270,9 @@ def _tilt(rec: xr.Dataset, config: FeatureConfig) -> xr.DataArray:
     """Gravity-up direction of a corrected Recording with the configured method (or,
     without the sensors it needs, ``config.no_gyro_method``)."""
     method, params, use_mag = _tilt_method(rec, config)
-    q = _filters.estimate(rec, method, use_mag=use_mag, **params)
+    with warnings.catch_warnings():  # the features record the gaps themselves
+        warnings.filterwarnings("ignore", r"estimate\(.*gaps='segments'")
+        q = _filters.estimate(rec, method, use_mag=use_mag, gaps="segments", **params)
     return _filters.gravity(q)
 
 
@@ -364,9 +371,6 @@ def session_features(
         )
     _schema.validate(recording, allow_nan=True, check_units=check_units)
     has_gyr = "gyr" in recording
-    for v in ("acc", "gyr"):
-        if v in recording and not np.isfinite(recording[v].values).all():
-            raise RecordingError(f"the Recording's {v!r} has non-finite samples")
     rec, off = _corrected(recording, config, calibration)
     fs = float(rec.attrs["fs"])
     n = rec.sizes["time"]
@@ -382,7 +386,7 @@ def session_features(
         for k in keys:
             reasons.setdefault(k, reason)
 
-    out: dict[str, float] = {"n_samples": n, "duration_s": n / fs}
+    out: dict[str, float] = {"duration_s": n / fs}
     offset_keys = [f"gyr_offset_{a}" for a in "xyz"]
     speed_keys = [k for k in spec if k.startswith("angular_speed_moving_q")]
     if has_gyr:
@@ -392,11 +396,30 @@ def session_features(
 
     method, _, _ = _tilt_method(rec, config)
     g = _tilt(rec, config)
-    gv = g.values
+    # samples in gaps (non-finite sensor values, hence no tilt) are left out below;
+    # the immobility rules count them as neither still nor moving
+    valid = np.isfinite(g.values).all(axis=1)
+    for v in ("acc", "gyr"):
+        if v in rec:
+            valid &= np.isfinite(rec[v].values).all(axis=1)
+    n_valid = int(valid.sum())
+    if n_valid < 2 * fs:
+        raise RecordingError(
+            f"the recording has too few samples outside its gaps ({n_valid} of {n}; at "
+            "least 2 s needed)"
+        )
+    gaps = (
+        {}
+        if n_valid == n
+        else {"gaps": f"{n - n_valid} of {n} samples in gaps left out"}
+    )
+    out["n_samples"] = n_valid
+    gv = g.values[valid]
     if has_gyr:
-        speed = _behavior.angular_speed(rec)
-        sp = np.asarray(speed, float)
-        imm = _immobile(speed, config, config.threshold_deg_s)
+        # a gap is never still: a speed above any threshold there (left out below)
+        speed = _behavior.angular_speed(rec).fillna(1e9)
+        sp = np.asarray(speed, float)[valid]
+        imm = _immobile(speed, config, config.threshold_deg_s)[valid]
         rule = (
             f"gyroscope: angular speed < {config.threshold_deg_s:g} deg/s, gaps < "
             f"{config.merge_gap_s:g} s merged, periods < {config.min_duration_s:g} s "
@@ -411,7 +434,7 @@ def session_features(
             merge_gap_s=config.merge_gap_s,
             min_duration_s=config.min_duration_s,
         )
-        imm = np.asarray(still, dtype=bool)
+        imm = np.asarray(still, dtype=bool)[valid]
         rule = f"accelerometer: {still.attrs['rule_description']}"
     moving = ~imm
     out["immobile_fraction"] = float(imm.mean())
@@ -422,19 +445,21 @@ def session_features(
         undefined(auto_keys, NO_GYRO + " (valley of the angular-speed histogram)")
     else:
         try:
-            thr = _behavior.valley_threshold(speed)
+            thr = _behavior.valley_threshold(speed[valid])
         except ValueError as exc:
             undefined(auto_keys, str(exc))
         else:
             out["immobility_threshold_auto"] = float(thr)
-            out["immobile_fraction_auto"] = float(_immobile(speed, config, thr).mean())
+            out["immobile_fraction_auto"] = float(
+                _immobile(speed, config, thr)[valid].mean()
+            )
 
     mesh = _sphere.sphere_mesh(config.mesh_n)
     for key, mask in (("visited_fraction", None), ("visited_fraction_moving", moving)):
         if mask is not None and not mask.any():
             undefined([key], "no moving samples")
             continue
-        tmap = _sphere.tilt_map(g, mesh=mesh, mask=mask)
+        tmap = _sphere.tilt_map(g[valid], mesh=mesh, mask=mask)
         out[key] = _sphere.visited_fraction(
             tmap, mesh, min_count=config.visited_min_count, by="area"
         )
@@ -454,7 +479,12 @@ def session_features(
     if not has_gyr:
         undefined(["circling_index", *speed_keys], NO_GYRO)
     elif moving.any():
-        out["circling_index"] = _behavior.circling_index(rec, g, moving=moving)
+        whole = n_valid == n
+        out["circling_index"] = _behavior.circling_index(
+            rec if whole else rec.isel(time=valid),
+            g if whole else g[valid],
+            moving=moving,
+        )
         for q in config.speed_quantiles:
             key = f"angular_speed_moving_q{_tag(100 * q)}"
             out[key] = float(np.quantile(sp[moving], q))
@@ -462,11 +492,12 @@ def session_features(
         undefined(["circling_index", *speed_keys], "no moving samples")
 
     to_g = _units.conversion_factor(rec["acc"].attrs["units"], "g")
+    # DBA is NaN where its window touches a gap
     out["dba_mean"] = float(
-        np.mean(_behavior.dba(rec, window_s=config.dba_window_s)) * to_g
+        np.nanmean(_behavior.dba(rec, window_s=config.dba_window_s)) * to_g
     )
     out["odba_mean"] = float(
-        np.mean(_behavior.odba(rec, window_s=config.dba_window_s)) * to_g
+        np.nanmean(_behavior.odba(rec, window_s=config.dba_window_s)) * to_g
     )
     gz = np.clip(gv[:, 2] / np.linalg.norm(gv, axis=1), -1.0, 1.0)
     tilt_deg = np.degrees(np.arccos(gz))
@@ -478,5 +509,6 @@ def session_features(
         "sensors": ", ".join(v for v in _filters.SENSORS if v in recording),
         "tilt_method": method,
         "immobility_rule": rule,
+        **gaps,
     }
     return _dataset(out, config, attrs, reasons)

@@ -241,12 +241,14 @@ def _assemble(
     values = {k: np.full(n, np.nan) for k in spec}
     status = np.empty(n, dtype=object)
     error = np.empty(n, dtype=object)
+    notes = np.full(n, "", dtype=object)
     for i, sid in enumerate(table["session"]):
         r = results[sid]
         status[i], error[i] = r["status"], r["error"]
         if r["features"] is not None:
             for k in spec:
                 values[k][i] = float(r["features"][k].values)
+            notes[i] = str(r["features"].attrs.get("notes", ""))
     data = {
         k: ("session", values[k], {"units": u, "long_name": ln})
         for k, (u, ln) in spec.items()
@@ -256,6 +258,11 @@ def _assemble(
         "session",
         error.astype(str),
         {"long_name": "why the session failed (empty when ok)"},
+    )
+    data["notes"] = (
+        "session",
+        notes.astype(str),
+        {"long_name": "why features of a session that ran are NaN (feature: reason)"},
     )
 
     def coord(col):
@@ -328,7 +335,9 @@ def run_cohort(
     -------
     xarray.Dataset
         Dimension ``session``; the features of :func:`~tiltlab.cohort.session_features`
-        (NaN for failed sessions), ``status`` ("ok"/"failed") and ``error``;
+        (NaN for failed sessions), ``status`` ("ok"/"failed"), ``error`` and
+        ``notes`` (for a session that ran, why some of its features are NaN, e.g. no
+        gyroscope or no immobile sample);
         coordinates ``subject``, ``group``, ``timepoint``, ``file``, ``reader`` and the
         covariates; attrs ``feature_config`` (JSON), ``config_hash``, ``n_sessions``,
         ``n_ok``, ``n_failed``, ``n_computed`` (sessions computed in this run,
@@ -416,7 +425,8 @@ def run_cohort(
 
 @dataclass(frozen=True)
 class CohortSummary:
-    """Outcome of a cohort run: counts and, per failed session, the reason."""
+    """Outcome of a cohort run: counts, per failed session the reason, and per session
+    that ran with NaN features why they are NaN."""
 
     n_sessions: int
     n_ok: int
@@ -424,12 +434,14 @@ class CohortSummary:
     n_computed: int | None = None
     n_cached: int | None = None
     failures: dict[str, str] = field(default_factory=dict)
+    notes: dict[str, str] = field(default_factory=dict)
 
     def __str__(self) -> str:
         head = f"{self.n_sessions} sessions: {self.n_ok} ok, {self.n_failed} failed"
         if self.n_computed is not None:
             head += f" ({self.n_computed} computed, {self.n_cached} from cache)"
         lines = [head] + [f"  failed {s}: {e}" for s, e in self.failures.items()]
+        lines += [f"  NaN features in {s}: {n}" for s, n in self.notes.items()]
         return "\n".join(lines)
 
 
@@ -441,6 +453,11 @@ def summary(features: xr.Dataset) -> CohortSummary:
     err = features["error"].values.astype(str)
     sessions = features["session"].values.astype(str)
     failed = status == "failed"
+    notes = (
+        features["notes"].values.astype(str)
+        if "notes" in features
+        else np.full(status.size, "")
+    )
 
     def attr(k):
         v = features.attrs.get(k)
@@ -453,6 +470,7 @@ def summary(features: xr.Dataset) -> CohortSummary:
         n_computed=attr("n_computed"),
         n_cached=attr("n_cached"),
         failures={s: e for s, e, f in zip(sessions, err, failed) if f},
+        notes={s: n for s, n in zip(sessions, notes, strict=True) if n and n != "nan"},
     )
 
 
