@@ -1,0 +1,294 @@
+"""``tiltlab`` command line: inspect, validate, convert and fetch data; run cohorts.
+
+Examples
+--------
+::
+
+    tiltlab fetch --all                # download (or verify in the mirror) every registered file
+    tiltlab info broad:2               # summary of BROAD trial 2
+    tiltlab info deployment.nc         # what a file looks like (tag-tools NetCDF …) and its summary
+    tiltlab validate session.nc        # check a saved Recording against the contract
+    tiltlab info my_session.csv --mapping mapping.json   # your own CSV, with a column mapping
+    tiltlab convert deployment.nc --out session.nc       # tag-tools NetCDF → Recording
+    tiltlab convert my_session.csv --mapping mapping.json --out session.nc
+    tiltlab convert board/ --mapping files.json --out session.nc  # one file per sensor
+    tiltlab cohort init data/ --pattern "{group}/{subject}_{timepoint}.nc" --out manifest.csv
+    tiltlab cohort run manifest.csv --out features.nc --workers 2
+    tiltlab cohort show features.nc
+
+Every user error (missing file, bad JSON, bad mapping, a Recording that breaks the
+contract) is reported as one line ``tiltlab: ...`` on stderr with a non-zero exit
+status, never as a traceback (set ``TILTLAB_DEBUG=1`` to see one). A file that is not
+a tiltlab Recording (a tag-tools NetCDF, a MATLAB file …) is named for what it looks
+like, with the command that converts it. Values that decisively contradict their unit
+labels are refused; ``--no-check-units`` (on ``info``, ``validate``, ``convert`` and
+``cohort run``) accepts the labels as they are — in a cohort manifest the same switch
+is ``reader_options {"check_units": false}``. Quality warnings (clipped samples,
+values doubtful for their units: :mod:`tiltlab.quality`) are printed by ``tiltlab
+validate`` and ``tiltlab convert`` as lines ``warning: ...``, and leave the exit status 0.
+"""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import os
+import sys
+from collections.abc import Sequence
+
+from ._common import (
+    EXIT_ERROR,
+    EXIT_REJECTED,
+    UserError,
+    _MAPPING_HELP,
+    _add_check_units,
+    _message,
+    _positive_int,
+    _user_errors,
+)
+from .files import (
+    _cmd_convert,
+    _cmd_fetch,
+    _cmd_info,
+    _cmd_validate,
+)
+from .cohort import (
+    MAIN_FEATURES,
+    _cmd_cohort_init,
+    _cmd_cohort_run,
+    _cmd_cohort_show,
+    _scheduler,
+)
+
+__all__ = ["main", "run"]
+
+
+def _parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="tiltlab",
+        description=__doc__.splitlines()[0],
+        epilog="Set TILTLAB_DEBUG=1 to see tracebacks.",
+    )
+    sub = parser.add_subparsers(dest="cmd", required=True, metavar="COMMAND")
+    p_fetch = sub.add_parser(
+        "fetch", help="fetch registered data files (checksums verified)"
+    )
+    p_fetch.add_argument(
+        "names",
+        nargs="*",
+        help="registry names, e.g. broad/02_undisturbed_slow_rotation_B.hdf5",
+    )
+    p_fetch.add_argument("--all", action="store_true", help="every registered file")
+    for name, help_ in (
+        ("info", "summarise a recording"),
+        ("validate", "validate a recording against the contract"),
+    ):
+        p = sub.add_parser(
+            name,
+            help=help_,
+            description=f"{help_[0].upper()}{help_[1:]}: broad:N, fayat:example, "
+            "fayat:tumble, a .nc / .hdf5 / .mat file, or your own CSV with --mapping.",
+            epilog=_MAPPING_HELP,
+            formatter_class=argparse.RawDescriptionHelpFormatter,
+        )
+        p.add_argument("source", help="data source or file")
+        p.add_argument(
+            "--mapping",
+            metavar="MAPPING.json",
+            help="column/unit mapping (JSON) for a generic CSV file, or a multi-file "
+            'mapping with "files"',
+        )
+        _add_check_units(p)
+    p_conv = sub.add_parser(
+        "convert",
+        help="convert a file into a NetCDF Recording",
+        description="Convert SOURCE into a validated NetCDF Recording (tiltlab.io.read "
+        "then tiltlab.io.save_netcdf): a tag-tools NetCDF archive, a BROAD trial, a "
+        "tiltlab NetCDF, your own CSV with --mapping, or one file per sensor with a "
+        'mapping that has "files" (SOURCE is then the folder of those files). Prints '
+        "one summary line, after any quality warnings ('warning: ...').",
+        epilog=_MAPPING_HELP,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    p_conv.add_argument("source", metavar="SOURCE", help="file (or folder) to convert")
+    p_conv.add_argument(
+        "--mapping", metavar="MAPPING.json", help="column/unit or multi-file mapping"
+    )
+    p_conv.add_argument("--out", required=True, help="Recording to write (.nc)")
+    p_conv.add_argument(
+        "--preset",
+        metavar="NAME",
+        help="device axes convention (android, ios, tagtools, animal ...), for sources "
+        "whose axes are not in the sensor frame yet",
+    )
+    p_conv.add_argument(
+        "--force", action="store_true", help="replace an existing --out file"
+    )
+    _add_check_units(p_conv)
+
+    p_cohort = sub.add_parser("cohort", help="cohort manifests and features")
+    csub = p_cohort.add_subparsers(dest="cohort_cmd", required=True, metavar="COMMAND")
+    p_init = csub.add_parser(
+        "init",
+        help="write a manifest from the files of a folder",
+        description="Write a cohort manifest (one row per session) from the files of "
+        "FOLDER whose relative paths match PATTERN.",
+    )
+    p_init.add_argument("folder", metavar="FOLDER")
+    p_init.add_argument(
+        "--pattern",
+        required=True,
+        help='relative path with fields, e.g. "{group}/{subject}_{timepoint}.nc"',
+    )
+    p_init.add_argument("--reader", default="netcdf", help="reader (default netcdf)")
+    p_init.add_argument(
+        "--group", help="group of every session when the pattern has no {group}"
+    )
+    p_init.add_argument(
+        "--out",
+        default="manifest.csv",
+        help="manifest to write (default manifest.csv); file paths in it are "
+        "relative to its folder",
+    )
+    p_init.add_argument(
+        "--reader-options",
+        metavar="JSON|FILE.json",
+        help="reader options for every session, as JSON text or a JSON file; for "
+        "--reader csv, the column/unit mapping (see 'tiltlab info --help')",
+    )
+    p_init.add_argument(
+        "--force", action="store_true", help="replace an existing manifest"
+    )
+
+    p_run = csub.add_parser(
+        "run",
+        help="compute the features of every session of a manifest",
+        description="Compute per-session features for a manifest and write them. Exit "
+        "status 0 if every session succeeded, 1 if any failed (listed on stderr), 2 if "
+        "the manifest or config is rejected.",
+    )
+    p_run.add_argument("manifest", metavar="MANIFEST")
+    p_run.add_argument("--out", required=True, help="feature file to write (.nc)")
+    p_run.add_argument(
+        "--workers",
+        type=_positive_int("--workers"),
+        help="worker processes (default: automatic)",
+    )
+    p_run.add_argument(
+        "--scheduler",
+        type=_scheduler,
+        metavar="ADDRESS|dask|processes",
+        help="'processes' (local pool), 'dask' (local dask.distributed cluster) or the "
+        "address of a running dask scheduler (tcp://host:8786); default serial",
+    )
+    p_run.add_argument("--config", metavar="CONFIG.json", help="feature configuration")
+    p_run.add_argument("--cache-dir", metavar="DIR", help="per-session feature cache")
+    p_run.add_argument("--no-progress", action="store_true", help="no progress bar")
+    _add_check_units(
+        p_run,
+        ' for every session (in a manifest row: reader_options {"check_units": false})',
+    )
+
+    p_show = csub.add_parser(
+        "show",
+        help="print a feature file as a table, with its config",
+    )
+    p_show.add_argument("features", metavar="FEATURES.nc")
+    p_show.add_argument(
+        "--max-features",
+        type=_positive_int("--max-features"),
+        default=len(MAIN_FEATURES),
+        help=f"features shown as columns (default {len(MAIN_FEATURES)}: the main ones)",
+    )
+    p_show.add_argument("--all", action="store_true", help="every feature")
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run the ``tiltlab`` command.
+
+    Parameters
+    ----------
+    argv : sequence of str, optional
+        Arguments (default ``sys.argv[1:]``).
+
+    Returns
+    -------
+    int
+        Exit status: 0 success, 1 an error or a failed session, 2 a rejected input
+        (usage, cohort manifest or config).
+    """
+    parser = _parser()
+    try:
+        args = parser.parse_args(argv)
+    except SystemExit as exc:  # usage errors and --help: argparse has printed them
+        return exc.code if isinstance(exc.code, int) else EXIT_REJECTED
+    debug = os.environ.get("TILTLAB_DEBUG", "") not in ("", "0")
+    try:
+        if args.cmd == "fetch":
+            return _cmd_fetch(args, parser)
+        if args.cmd == "info":
+            return _cmd_info(args)
+        if args.cmd == "validate":
+            return _cmd_validate(args)
+        if args.cmd == "convert":
+            return _cmd_convert(args)
+        if args.cmd == "cohort":
+            return {
+                "init": _cmd_cohort_init,
+                "run": _cmd_cohort_run,
+                "show": _cmd_cohort_show,
+            }[args.cohort_cmd](args)
+    except UserError as exc:
+        if debug:
+            raise
+        print(f"tiltlab: {exc}", file=sys.stderr)
+        return exc.code
+    except KeyboardInterrupt:
+        print("tiltlab: interrupted", file=sys.stderr)
+        return 130
+    except Exception as exc:
+        if debug:
+            raise
+        if isinstance(exc, _user_errors()):
+            print(f"tiltlab: {_message(exc)}", file=sys.stderr)
+        else:  # not expected: still one line, the traceback on request
+            print(
+                f"tiltlab: unexpected error ({type(exc).__name__}: {_message(exc)}); "
+                "set TILTLAB_DEBUG=1 to see the traceback",
+                file=sys.stderr,
+            )
+        return EXIT_ERROR
+    parser.error(f"unknown command {args.cmd!r}")  # pragma: no cover
+    return EXIT_REJECTED  # pragma: no cover
+
+
+def run(command: str) -> int:
+    """Run one ``tiltlab`` command line from Python (a notebook), as a shell would.
+
+    The line is echoed as ``$ tiltlab ...``; what the command writes to stderr (its
+    one-line errors and ``warning:`` lines) is shown with its output.
+
+    Parameters
+    ----------
+    command : str
+        The arguments, e.g. ``"convert tag.csv --mapping tag.json --out tag.nc"``.
+
+    Returns
+    -------
+    int
+        The exit status (see :func:`main`).
+
+    Examples
+    --------
+    >>> from tiltlab import cli
+    >>> cli.run("info broad:2 --help")  # doctest: +SKIP
+    """
+    import shlex
+
+    print(f"$ tiltlab {command}")
+    with contextlib.redirect_stderr(sys.stdout):
+        status = main(shlex.split(command))
+    if status:
+        print(f"(exit status {status})")
+    return status

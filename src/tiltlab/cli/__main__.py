@@ -1,0 +1,7 @@
+"""``python -m tiltlab.cli``: the ``tiltlab`` command."""
+
+import sys
+
+from . import main
+
+sys.exit(main())
