@@ -107,7 +107,8 @@ def mahony(
     mag : array_like, shape (N, 3), optional
         Magnetometer (any unit): 9D, ENU world frame.
     kp, ki : float
-        Proportional (rad/s) and integral (rad/s²) gains, ``>= 0``. The default
+        Proportional (rad/s) and integral (rad/s²) gains, ``>= 0``, with
+        ``kp/fs <= 2`` and ``ki/fs² <= 1`` (larger steps diverge). The default
         ``ki = 0.03`` (not the usual 0.3, which ``ahrs`` keeps) because a large integral
         gain turns sustained linear accelerations into a wrong gyro-bias estimate: 29°
         of tilt RMSE on BROAD's fast translation and combined trials against 14° at 0.03
@@ -126,6 +127,15 @@ def mahony(
     acc, gyr, m, use_mag = sensor_inputs(acc, gyr, mag)
     kp = _v.nonnegative(kp, "kp")
     ki = _v.nonnegative(ki, "ki")
+    # one step turns the estimate by at most kp/fs (+ the bias step ki/fs²) radians
+    # toward the accelerometer; beyond ~2 rad it overshoots and the filter diverges
+    if kp / fs > 2.0 or ki / fs**2 > 1.0:
+        raise ValueError(
+            f"kp = {kp:g} rad/s and ki = {ki:g} rad/s² are too large for fs = {fs:g} "
+            f"Hz: the correction per sample (kp/fs = {kp / fs:.3g} rad, ki/fs² = "
+            f"{ki / fs**2:.3g} rad) must stay below 2 and 1 rad, or the filter "
+            "overshoots and diverges"
+        )
     if b0 is None:
         b0 = np.zeros(3)
     else:
