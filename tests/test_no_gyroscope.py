@@ -396,3 +396,26 @@ def test_cohort_table_says_why_features_are_nan(tmp_path):
     assert notes[1].count("needs a gyroscope") <= 2  # grouped by reason
     text = str(cohort.summary(table))
     assert "NaN features in s1" in text and "NaN features in s0" not in text
+
+
+def test_realism_table_compares_like_with_like_without_a_gyroscope():
+    """With one recording lacking a gyroscope, every column uses the accelerometer
+    rule (no gyroscope rows); with both complete, the gyroscope rule; acceleration
+    percentiles skip gaps and equal the all-finite ones elsewhere."""
+    rec = _session(60.0)
+    both = B.realism_table({"a": rec, "b": _session(60.0, seed=4)})
+    assert both.attrs["rule"] == "gyroscope"
+    assert "gyro spectral peak (Hz)" in both.index
+    mixed = B.realism_table({"a": rec, "tag": _acc_only(rec)})
+    assert mixed.attrs["rule"] == "accelerometer"
+    assert not any("gyro" in row or "deg/s" in row for row in mixed.index)
+    np.testing.assert_allclose(mixed["a"].values, mixed["tag"].values)
+    imm = B.immobility(rec, rule="accelerometer")
+    row = "immobile fraction (VeDBA rule)"
+    assert mixed.loc[row, "a"] == pytest.approx(float(imm.mean()))
+    gappy = _acc_only(rec).copy(deep=True)
+    gappy["acc"][100:110] = np.nan
+    with_gap = B.realism_table({"tag": gappy})
+    assert np.isfinite(with_gap["tag"].values).all()
+    with pytest.raises(RecordingError, match="gyroscope"):
+        B.realism_table({"tag": _acc_only(rec)}, rule="gyroscope")

@@ -1,11 +1,13 @@
 """Chapter 2 with another seed, smaller sizes and a BROAD trial (m/s², rad/s, 285.7 Hz)
-as the real recording of the realism check."""
+as the real recording of the realism check; variant "tag": an accelerometer + magnetometer
+bio-logging tag without a gyroscope as that recording."""
 
 from __future__ import annotations
 
 from pathlib import Path
 
 from ._common import printed
+from ._foreign import convert
 
 PARAMS = {
     "SOURCE": "broad:3",
@@ -41,3 +43,36 @@ def check(nb_path: Path, params: dict) -> str:
             f"{expected:.1%} below {params['THRESHOLD_DEG_S']:g} °/s"
         )
     return f"{got:.1%} of {params['SOURCE']} below {threshold:g} °/s (package: {expected:.1%})"
+
+
+def prepare_tag(tmp: Path) -> dict:
+    """An accelerometer + magnetometer tag from another lab (no gyroscope, a few short NaN
+    gaps), converted by ``tiltlab convert``, as the real recording of the realism check:
+    immobility from the accelerometer's VeDBA rule, the gyroscope's comparisons skipped
+    with a line."""
+    return {**PARAMS, "SOURCE": str(convert("tag", tmp))}
+
+
+def check_tag(nb_path: Path, params: dict) -> str:
+    """The immobile fraction the chapter prints for the tag equals ``behavior.immobility``
+    applied directly, with the rule it names (the accelerometer's, without a gyroscope),
+    and the chapter says what it skips."""
+    from tiltlab import behavior, datasets
+
+    real = datasets.load(params["SOURCE"])
+    immobile = behavior.immobility(real)
+    expected = float(immobile.mean())
+    found = printed(nb_path, r"immobile ([0-9.]+)% of the time", "immobile fraction")
+    got = float(found[0]) / 100
+    if abs(got - expected) > 0.0005:
+        raise AssertionError(
+            f"chapter says {got:.1%} immobile, behavior.immobility gives {expected:.1%}"
+        )
+    rule = printed(nb_path, r"immobility: (.+)", "immobility rule")[0].strip()
+    if rule != immobile.attrs["rule_description"]:
+        raise AssertionError(f"chapter used the rule {rule!r}")
+    printed(nb_path, r"has no gyroscope: .+ skipped", "line saying what is skipped")
+    return f"immobile fraction {got:.1%} (package: {expected:.1%}; {rule})"
+
+
+VARIANTS = {"tag": prepare_tag}
