@@ -30,3 +30,15 @@ def data_mirror() -> Path:
             pytest.fail(f"real data required but unavailable: {why}")
         pytest.skip(why)
     return datasets.data_dir()
+
+
+@pytest.fixture(scope="session")
+def foreign(data_mirror) -> Path:
+    """The mirror's recordings from other labs (``foreign/``), in their own formats."""
+    path = data_mirror / "foreign"
+    if not path.is_dir():
+        why = f"{path} is missing (the foreign recordings)"
+        if os.environ.get("TILTLAB_REQUIRE_DATA", "") not in ("", "0"):
+            pytest.fail(f"real data required but unavailable: {why}")
+        pytest.skip(why)
+    return path

@@ -109,10 +109,8 @@ def test_cohort_manifest_check_units_switch(tmp_path):
     assert load_session(row, tmp_path)["acc"].attrs["units"] == "g"
 
 
-def test_detect_foreign_recordings(data_mirror):
-    d = data_mirror / "foreign"
-    if not d.is_dir():
-        pytest.skip("foreign recordings not in this mirror")
+def test_detect_foreign_recordings(foreign):
+    d = foreign
     mat = (
         d
         / "board_sunsided"

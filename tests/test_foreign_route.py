@@ -6,7 +6,6 @@ line as a lab would use it."""
 from __future__ import annotations
 
 import json
-import os
 import warnings
 
 import numpy as np
@@ -26,17 +25,6 @@ ROUTES = {
     "tag": ("twlogger_tag", "tag_twlogger/T1D0711-00.CSV", False),
     "foot": ("gaitmap_foot", "foot_gaitmap/imu_sample.csv", True),
 }
-
-
-@pytest.fixture(scope="module")
-def foreign(data_mirror):
-    path = data_mirror / "foreign"
-    if not path.is_dir():
-        why = f"{path} is missing (the foreign recordings)"
-        if os.environ.get("TILTLAB_REQUIRE_DATA", "") not in ("", "0"):
-            pytest.fail(f"real data required but unavailable: {why}")
-        pytest.skip(why)
-    return path
 
 
 @pytest.fixture(scope="module")

@@ -1,25 +1,12 @@
 """Real recordings made by other projects, read through read_csv / read_multi and a
 mapping (files in TILTLAB_DATA_DIR/foreign, described in its README.md)."""
 
-import os
-
 import numpy as np
 import pandas as pd
 import pytest
 
 from tiltlab import io, schema
 from tiltlab.io import multi
-
-
-@pytest.fixture(scope="module")
-def foreign(data_mirror):
-    path = data_mirror / "foreign"
-    if not path.is_dir():
-        why = f"{path} is missing (the foreign recordings)"
-        if os.environ.get("TILTLAB_REQUIRE_DATA", "") not in ("", "0"):
-            pytest.fail(f"real data required but unavailable: {why}")
-        pytest.skip(why)
-    return path
 
 
 def _board_mapping():

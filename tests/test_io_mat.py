@@ -11,11 +11,8 @@ from tiltlab.io.mat import describe_mat, list_variables, mat_version, read_matri
 
 
 @pytest.fixture(scope="module")
-def board_dir(data_mirror) -> Path:
-    d = data_mirror / "foreign" / "board_sunsided"
-    if not d.is_dir():
-        pytest.skip(f"{d} is missing (foreign recordings not in this mirror)")
-    return d
+def board_dir(foreign) -> Path:
+    return foreign / "board_sunsided"
 
 
 def test_v5_roundtrip_keeps_matlab_shape(tmp_path):

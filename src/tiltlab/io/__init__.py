@@ -14,7 +14,8 @@ Supported formats
   on a regular grid or resampled from a jittery clock (``clock="resample"``).
 * Exports with one file per sensor, each on its own clock (``read_multi``).
 * Mappings for public recordings from other labs (``mapping_template``).
-* tag-tools (animaltags) NetCDF archives, NetCDF-4 or NetCDF-3 (``read_tagtools``).
+* tag-tools (animaltags) NetCDF archives, NetCDF-4 or NetCDF-3 (``read_tagtools``;
+  ``write_tagtools`` writes that layout).
 * One numeric variable of a MATLAB file, v4–v7 or v7.3/HDF5 (``read_matrix``), in
   MATLAB's own shape.
 * NetCDF via h5netcdf (``save_netcdf`` / ``load_netcdf``), exact round trip
@@ -39,7 +40,7 @@ from .netcdf import (
     open_netcdf,
     save_netcdf,
 )
-from .tagtools import read_tagtools
+from .tagtools import read_tagtools, write_tagtools
 
 __all__ = [
     "ReadError",
@@ -52,6 +53,7 @@ __all__ = [
     "read_csv",
     "read_csv_mapping",
     "read_tagtools",
+    "write_tagtools",
     "read_matrix",
     "read_multi",
     "mapping_template",
