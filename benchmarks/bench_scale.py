@@ -343,8 +343,17 @@ def main() -> None:
         rows, failed = [], []
         for name in names:
             m = F.METHODS[name]
-            for use_mag in (False, True) if m.supports_mag else (False,):
-                row = {"method": name, "dims": "9D" if use_mag else "6D", "n": n}
+            if m.requires_mag:  # e.g. davenport: acc + mag only
+                modes: tuple[bool, ...] = (True,)
+            else:
+                modes = (False, True) if m.supports_mag else (False,)
+            for use_mag in modes:
+                dims = "9D" if use_mag else "6D"
+                row = {
+                    "method": name,
+                    "dims": "A+M" if m.requires_mag else dims,
+                    "n": n,
+                }
                 if name in SLOW and n_slow < n:
                     r = run_one(name, tmp, n_slow, use_mag, args.timeout, tmp)
                     row.update(r, n_run=n_slow, extrapolated=True)
