@@ -47,6 +47,21 @@ def _missing_columns_message(
     return msg
 
 
+def read_table_or_fail(path, **kwargs) -> pd.DataFrame:
+    """:func:`pandas.read_csv`, its parse errors raised as one :class:`ReadError`
+    naming the file."""
+    try:
+        return pd.read_csv(path, **kwargs)
+    except (
+        pd.errors.ParserError,
+        pd.errors.EmptyDataError,
+        UnicodeDecodeError,
+        ValueError,
+        TypeError,
+    ) as exc:
+        raise ReadError(f"{path}: not a readable CSV table ({exc})") from None
+
+
 def _read_table(
     path: PathLike,
     required: Sequence[str],
@@ -69,16 +84,7 @@ def _read_table(
                 raise ReadError(
                     f"{path}: last line is incomplete (no final newline): truncated file?"
                 )
-    try:
-        df = pd.read_csv(path, **kwargs)
-    except (
-        pd.errors.ParserError,
-        pd.errors.EmptyDataError,
-        UnicodeDecodeError,
-        ValueError,
-        TypeError,
-    ) as exc:
-        raise ReadError(f"{path}: not a readable CSV table ({exc})") from None
+    df = read_table_or_fail(path, **kwargs)
     missing = [c for c in required if c not in df.columns]
     if missing:
         raise ReadError(_missing_columns_message(path, df, missing, roles))

@@ -14,7 +14,12 @@ import xarray as xr
 from .. import _validate, schema
 from .. import quality as _quality
 from . import clock as _clock
-from ._common import PathLike, ReadError, _missing_columns_message
+from ._common import (
+    PathLike,
+    ReadError,
+    _missing_columns_message,
+    read_table_or_fail,
+)
 from .clock import CLOCK_POLICIES, GAP_POLICIES, MAX_GAP, TIME_UNITS
 from .mapping import FS_RANGE, check_mapping, load_mapping
 
@@ -147,16 +152,7 @@ def read_frame(
     kwargs = dict(read_kwargs)
     if not multi and not kwargs.get("index_col"):
         kwargs["usecols"] = lambda c: str(c) in want
-    try:
-        df = pd.read_csv(path, **kwargs)
-    except (
-        pd.errors.ParserError,
-        pd.errors.EmptyDataError,
-        UnicodeDecodeError,
-        ValueError,
-        TypeError,
-    ) as exc:
-        raise ReadError(f"{path}: not a readable CSV table ({exc})") from None
+    df = read_table_or_fail(path, **kwargs)
     df.columns = [_flat(c) for c in df.columns]
     missing = [c for c in wanted if c not in df.columns]
     if missing:
