@@ -419,3 +419,30 @@ def test_realism_table_compares_like_with_like_without_a_gyroscope():
     assert np.isfinite(with_gap["tag"].values).all()
     with pytest.raises(RecordingError, match="gyroscope"):
         B.realism_table({"tag": _acc_only(rec)}, rule="gyroscope")
+
+
+def test_tumble_calibration_of_an_accelerometer_only_recording():
+    """Without a gyroscope the accelerometer calibration is the same as with one (same
+    still periods), no gyroscope offset is made up, gaps outside the periods are
+    accepted, a gap inside one is named, and missing periods say how to give them."""
+    from tiltlab import calibration as C
+    from tiltlab.simulate import tumble_test
+
+    rec = tumble_test(12, fs=100.0, seed=7, hold_s=4.0, move_s=1.0)
+    full = C.tumble_calibration(rec, trigger=rec["trigger"])
+    acc = rec.drop_vars("gyr")
+    alone = C.tumble_calibration(acc, trigger=rec["trigger"])
+    np.testing.assert_array_equal(alone.intervals, full.intervals)
+    np.testing.assert_allclose(alone.fit.offset, full.fit.offset, rtol=0, atol=0)
+    assert alone.calibration.gyr_offset is None and alone.gyr_stderr is None
+    assert "gyr_offset_stderr" not in alone.calibration.info
+    gappy = acc.copy(deep=True)
+    first_start = int(full.intervals[0, 0])
+    gappy["acc"][first_start - 5 : first_start - 1] = np.nan  # before the first period
+    same = C.tumble_calibration(gappy, intervals=full.intervals)
+    np.testing.assert_allclose(same.fit.offset, full.fit.offset, rtol=0, atol=0)
+    gappy["acc"][first_start + 1] = np.nan  # inside it
+    with pytest.raises(ValueError, match="still period 0 .*non-finite"):
+        C.tumble_calibration(gappy, intervals=full.intervals)
+    with pytest.raises(C.CalibrationError, match="no gyroscope.*intervals"):
+        C.tumble_calibration(acc)

@@ -60,3 +60,58 @@ def check(nb_path: Path, params: dict) -> str:
         f"{len(intervals)} still periods, first-pass gyro offset "
         f"{np.round(expected, 2).tolist()} deg/s (package agrees)"
     )
+
+
+def prepare_tag(tmp: Path) -> dict:
+    """An accelerometer + magnetometer tag from another lab (no gyroscope, short NaN
+    gaps), converted by ``tiltlab convert``, as the calibration recording: still periods
+    come from the accelerometer, the gyroscope parts say they are skipped."""
+    from ._foreign import convert
+
+    return {**prepare(tmp), "SOURCE": str(convert("tag", tmp))}
+
+
+def check_tag(nb_path: Path, params: dict) -> str:
+    """The still-period count and the offset fit's rms norm error the chapter prints
+    equal the package's: ``behavior.immobility`` (the accelerometer rule) and
+    ``calibration.fit_offsets`` on the means of those periods."""
+    import numpy as np
+
+    from tiltlab import behavior, calibration, datasets, units
+
+    rec = datasets.load(params["SOURCE"])
+    if "gyr" in rec:
+        raise AssertionError(f"{params['SOURCE']} has a gyroscope: not the tag")
+    printed(nb_path, r"has no gyroscope: still periods from the accelerometer", "skip")
+    still = behavior.immobility(rec, min_duration_s=params["MIN_STILL_S"])
+    intervals = calibration.mask_to_intervals(still.values)
+    found = printed(nb_path, r"still periods found: (\d+)", "still-period count")
+    if int(found[0]) != len(intervals):
+        raise AssertionError(
+            f"chapter found {found[0]} still periods, the accelerometer rule gives "
+            f"{len(intervals)}"
+        )
+    acc = units.acc_to_g(rec.acc.values, rec.acc.attrs["units"])
+    means = np.array([acc[s:e].mean(axis=0) for s, e in intervals])
+    sems = np.array(
+        [acc[s:e].std(axis=0, ddof=1) / np.sqrt(e - s) for s, e in intervals]
+    )
+    fit = calibration.fit_offsets(means, sem=sems)
+    expected = float(np.sqrt(np.mean(fit.residuals**2)))
+    rms = printed(
+        nb_path,
+        r"rms norm error at the static means after the fit: ([0-9.]+) g",
+        "rms norm error of the offset fit",
+    )
+    got = float(rms[0])
+    if abs(got - expected) > 6e-6:
+        raise AssertionError(
+            f"chapter rms norm error {got} g, package {expected:.5f} g"
+        )
+    return (
+        f"{len(intervals)} still periods (accelerometer rule), offset fit rms norm "
+        f"error {got:.5f} g (package: {expected:.5f} g)"
+    )
+
+
+VARIANTS = {"tag": prepare_tag}

@@ -52,3 +52,38 @@ def check(nb_path: Path, params: dict) -> str:
     return (
         f"Madgwick RMSE on {params['SOURCE']} {got:.3f} deg (package: {expected:.3f})"
     )
+
+
+def prepare_tag(tmp: Path) -> dict:
+    """The rerun's parameters with an accelerometer + magnetometer tag from another lab
+    (no gyroscope, short NaN gaps), converted by ``tiltlab convert``, as the user's own
+    recording of §6: only the low-pass tilt and the accelerometer immobility rule run."""
+    from ._foreign import convert
+
+    return {**prepare(tmp), "RAT_SOURCE": str(convert("tag", tmp))}
+
+
+def check_tag(nb_path: Path, params: dict) -> str:
+    """The immobile fraction the chapter prints for the tag (§6, summary) equals
+    ``behavior.immobility`` (the accelerometer rule) on the converted file."""
+    from tiltlab import behavior, datasets
+
+    rat = datasets.load(params["RAT_SOURCE"])
+    if "gyr" in rat:
+        raise AssertionError(f"{params['RAT_SOURCE']} has a gyroscope: not the tag")
+    printed(nb_path, r"has no gyroscope: of these methods only lowpass runs", "skip")
+    found = printed(
+        nb_path,
+        r"no gyroscope\): accelerometer rule -> ([0-9.]+)% immobile",
+        "immobile fraction of the tag",
+    )
+    got = float(found[0])
+    expected = 100 * float(behavior.immobility(rat).mean())
+    if abs(got - expected) > 0.051:
+        raise AssertionError(
+            f"chapter says {got:.1f} % immobile, behavior.immobility gives {expected:.1f} %"
+        )
+    return f"tag immobile {got:.1f} % by the accelerometer rule (package: {expected:.1f} %)"
+
+
+VARIANTS = {"tag": prepare_tag}

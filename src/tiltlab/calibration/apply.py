@@ -29,7 +29,13 @@ from .. import units as _units
 from .._validate import RecordingError
 from ._util import CalibrationError, mat3, read_in, read_temp_degc
 from .accel import EllipsoidFit, OffsetFit, fit_ellipsoid, fit_offsets
-from .static import StaticStats, detect_static, gyro_offset, static_means
+from .static import (
+    StaticStats,
+    detect_static,
+    gyro_offset,
+    static_intervals_from_trigger,
+    static_means,
+)
 from .temperature import TemperatureModel
 
 __all__ = [
@@ -289,13 +295,14 @@ def calibrate(
 class TumbleResult(NamedTuple):
     """Output of :func:`tumble_calibration`: the ``calibration``, the still ``intervals``,
     per-period accelerometer statistics ``acc_stats``, the accelerometer ``fit``
-    (:class:`OffsetFit` or :class:`EllipsoidFit`) and ``gyr_stderr`` (°/s)."""
+    (:class:`OffsetFit` or :class:`EllipsoidFit`) and ``gyr_stderr`` (°/s; None for a
+    recording without a gyroscope)."""
 
     calibration: Calibration
     intervals: np.ndarray
     acc_stats: StaticStats
     fit: OffsetFit | EllipsoidFit
-    gyr_stderr: np.ndarray
+    gyr_stderr: np.ndarray | None
 
 
 def tumble_calibration(
@@ -314,12 +321,16 @@ def tumble_calibration(
     Detects still periods (:func:`detect_static`, or ``intervals``/``trigger``), averages
     the accelerometer in each, fits ``model`` = ``"offsets"`` (:func:`fit_offsets`) or
     ``"ellipsoid"`` (:func:`fit_ellipsoid`, needs ≥ 9 well-spread poses), and takes
-    gyroscope offsets as medians during stillness.
+    gyroscope offsets as medians during stillness. A Recording without a gyroscope gets
+    the accelerometer calibration alone (no gyroscope offset); its still periods must
+    then be given (``intervals``, e.g. from the accelerometer rule of
+    :func:`tiltlab.behavior.immobility` through :func:`mask_to_intervals`, or
+    ``trigger``). Samples outside the still periods may be NaN (gaps).
 
     Parameters
     ----------
     rec : xarray.Dataset
-        Tumble-test Recording (``acc``, ``gyr`` with units; ``fs``).
+        Tumble-test Recording (``acc``, optional ``gyr``, with units; ``fs``).
     model : {"offsets", "ellipsoid"}
     intervals : array_like (P, 2), optional
         Still periods; default detected.
@@ -338,10 +349,25 @@ def tumble_calibration(
         raise TypeError(
             f"rec must be a Recording (xarray.Dataset), got {type(rec).__name__}"
         )
-    acc = read_in(rec, "acc", "g", need_fs=False)[0].values
-    gyr = read_in(rec, "gyr", "deg/s")[0].values
+    acc = read_in(rec, "acc", "g", need_fs=False, allow_nan=True)[0].values
+    has_gyr = "gyr" in rec
+    gyr = read_in(rec, "gyr", "deg/s", allow_nan=True)[0].values if has_gyr else None
     if full_scale_g is not None:
         full_scale_g = _v.positive(full_scale_g, "full_scale_g")
+    if intervals is None and trigger is None and not has_gyr:
+        raise CalibrationError(
+            "the Recording has no gyroscope, so its still periods cannot be found from "
+            "the angular speed: give intervals (e.g. calibration.mask_to_intervals of "
+            "behavior.immobility(rec), the accelerometer rule) or a trigger"
+        )
+    if intervals is None and not has_gyr:
+        fs = _v.check_fs(rec.attrs.get("fs"))
+        tr = _v.signal(trigger, "trigger", fs=fs, width=None, ndim=1).values
+        if tr.shape != (acc.shape[0],):
+            raise ValueError(
+                f"trigger must have shape ({acc.shape[0]},), got {tr.shape}"
+            )
+        intervals = static_intervals_from_trigger(tr, fs)
     if intervals is None:
         intervals = detect_static(
             rec,
@@ -355,7 +381,8 @@ def tumble_calibration(
         full_scale=full_scale_g,
         min_periods=3 if model == "offsets" else 9,
     )
-    go, gse = gyro_offset(gyr, intervals)
+    go, gse = gyro_offset(gyr, intervals) if has_gyr else (None, None)
+    gyr_info = {"gyr_offset_stderr": gse.tolist()} if has_gyr else {}
     if model == "offsets":
         fit = fit_offsets(stats.mean, sem=stats.sem)
         cal = Calibration(
@@ -364,7 +391,7 @@ def tumble_calibration(
             gyr_offset=go,
             info={
                 "acc_offset_stderr": fit.stderr.tolist(),
-                "gyr_offset_stderr": gse.tolist(),
+                **gyr_info,
                 "n_poses": int(fit.n),
                 "model": model,
             },
@@ -378,7 +405,7 @@ def tumble_calibration(
             gyr_offset=go,
             info={
                 "acc_offset_stderr": fit.offset_stderr.tolist(),
-                "gyr_offset_stderr": gse.tolist(),
+                **gyr_info,
                 "acc_matrix_stderr": fit.matrix_stderr.tolist(),
                 "n_poses": int(fit.n),
                 "model": model,

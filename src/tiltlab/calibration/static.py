@@ -302,10 +302,18 @@ def static_means(
     Notes
     -----
     The standard error assumes independent samples (white noise); with coloured noise it
-    is optimistic.
+    is optimistic. Samples outside the periods may be NaN (gaps); a period that holds a
+    non-finite sample is a ``ValueError``.
     """
-    a = _v.signal(x, "x", var=var, need_fs=False).values
+    # NaN (a gap) is allowed outside the still periods, not inside them
+    a = _v.signal(x, "x", var=var, need_fs=False, allow_nan=True).values
     iv = _check_intervals(intervals, a.shape[0])
+    for k, (s, e) in enumerate(iv):
+        if not np.isfinite(a[s:e]).all():
+            raise ValueError(
+                f"still period {k} (samples {s}:{e}) holds non-finite samples (a gap): "
+                "still periods must lie outside gaps"
+            )
     if full_scale is not None:
         full_scale = _v.positive(full_scale, "full_scale")
     min_periods = _v.integer(min_periods, "min_periods", minimum=0)
@@ -353,11 +361,16 @@ def gyro_offset(gyr, intervals) -> tuple[np.ndarray, np.ndarray]:
         Standard error: the larger of the spread of per-period medians over √P (P ≥ 2)
         and the white-noise standard error of a median, 1.2533 σ/√n.
     """
-    g = _v.signal(gyr, "gyr", need_fs=False).values
+    g = _v.signal(gyr, "gyr", need_fs=False, allow_nan=True).values
     iv = _check_intervals(intervals, g.shape[0])
     if iv.shape[0] == 0:
         raise CalibrationError("no still period: cannot estimate gyroscope offsets")
     allv = np.concatenate([g[s:e] for s, e in iv])
+    if not np.isfinite(allv).all():
+        raise ValueError(
+            "a still period holds non-finite gyr samples (a gap): still periods must "
+            "lie outside gaps"
+        )
     off = np.median(allv, axis=0)
     if iv.shape[0] >= 2:
         per = np.array([np.median(g[s:e], axis=0) for s, e in iv])
