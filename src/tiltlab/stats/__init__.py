@@ -15,6 +15,8 @@ One implementation each:
 * :mod:`~tiltlab.stats.mixed` — :func:`mixed_model` (MixedLM with convergence checks);
 * :mod:`~tiltlab.stats.power` — :func:`power_by_simulation`, :func:`animals_needed`
   for a user-supplied simulator (this package never imports :mod:`tiltlab.simulate`);
+* :mod:`~tiltlab.stats.design` — :func:`study_design`: groups, control, time points,
+  baseline, test directions and families read from a cohort table (:class:`StudyDesign`);
 * :mod:`~tiltlab.stats.tables` — :func:`between_groups`, :func:`against_baseline`
   (tidy tables from a cohort Dataset/DataFrame) and :func:`format_table` (Tables
   A1–A8 layout).
@@ -26,6 +28,7 @@ Example
 0.1875
 """
 
+from .design import StudyDesign, design_tables, session_table, study_design
 from .effects import (
     Interval,
     hodges_lehmann,
@@ -60,6 +63,7 @@ from .power import (
     noether_n_per_group,
     normal_shift,
     normal_shift_superiority,
+    observed_shift,
     power_by_simulation,
 )
 from .tables import (
@@ -72,6 +76,10 @@ from .tables import (
 )
 
 __all__ = [
+    "StudyDesign",
+    "design_tables",
+    "session_table",
+    "study_design",
     "FAYAT_TABLES",
     "FAYAT_TIME_POINTS",
     "fayat_table",
@@ -99,6 +107,7 @@ __all__ = [
     "mixed_model",
     "PowerResult",
     "normal_shift",
+    "observed_shift",
     "normal_shift_superiority",
     "noether_n_per_group",
     "power_by_simulation",
