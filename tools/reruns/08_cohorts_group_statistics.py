@@ -1,15 +1,23 @@
-"""Chapter 8 on a small simulated cohort with other groups and time points."""
+"""Chapter 8 on a small simulated cohort with other groups and time points, its design
+given as parameters as a lab would; and on a two-group, one-time-point cohort cut from
+another lab's accelerometer-only tag, with a session that fails."""
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 from ._common import printed
+from ._foreign import foreign_cohort
+
+SMALL = {"SEED": 3, "MAP_ANIMALS": 2, "POWER_N": [3, 4, 6, 8], "N_SIM_POWER": 100}
 
 
 def prepare(tmp: Path) -> dict:
-    """A cohort unlike chapter 8's default: three groups, three time points, 1-min sessions."""
-    from tiltlab import simulate
+    """A cohort unlike chapter 8's default: three groups, three time points, 1-min
+    sessions, read from its manifest (so Fayat et al.'s design is not assumed: the
+    control group, the family and the directions are parameters)."""
+    from tiltlab import simulate, stats
 
     design = simulate.CohortDesign.small().select(
         groups={"Arsanilate": 4, "ShamArsanilate": 4, "Healthy": 4},
@@ -25,12 +33,31 @@ def prepare(tmp: Path) -> dict:
         progress=False,
     )
     return {
+        **SMALL,
         "COHORT_MANIFEST": str(folder / "manifest.csv"),
-        "SEED": 3,
-        "MAP_ANIMALS": 2,
-        "POWER_N": [3, 4, 6, 8],
-        "N_SIM_POWER": 100,
+        "CONTROL_GROUP": "Healthy",
+        "FAMILIES": {
+            "Arsanilate": [
+                list(p) for p in stats.FAYAT_DESIGN["families"]["Arsanilate"]
+            ]
+        },
+        "DIRECTIONS": stats.FAYAT_DESIGN["directions"],
+        "FOCUS_GROUP": "Arsanilate",
     }
+
+
+def _design_lines(nb_path: Path) -> tuple[dict[str, int], int, int, int]:
+    """The groups with their animals, and the tests / features / compared time points
+    the chapter printed."""
+    found = printed(nb_path, r"\d+ groups: (.+); control: ", "design line")
+    groups = {g: int(n) for g, n in re.findall(r"(\S+) \((\d+) animals?\)", found[0])}
+    tests = printed(
+        nb_path,
+        r"(\d+) tests for (\d+) features, \d+ groups and (\d+) compared time point",
+        "test count line",
+    )
+    n_tests, n_features, n_post = map(int, tests[0])
+    return groups, n_tests, n_features, n_post
 
 
 def check(nb_path: Path, params: dict) -> str:
@@ -44,26 +71,16 @@ def check(nb_path: Path, params: dict) -> str:
     from tiltlab import cohort
 
     manifest = pd.read_csv(params["COHORT_MANIFEST"])
-    n_groups = manifest["group"].nunique()
+    groups, tests, n_features, post = _design_lines(nb_path)
     n_post = manifest["timepoint"].nunique() - 1
-    found = printed(
-        nb_path,
-        r"Computed (\d+) tables \((\d+) tests\) for (\d+) features, (\d+) groups, "
-        r"(\d+) time points after",
-        "table summary line",
-    )
-    tables, tests, n_features, groups, post = map(int, found[0])
-    if (groups, post) != (n_groups, n_post):
+    if sorted(groups) != sorted(manifest["group"].unique()) or post != n_post:
         raise AssertionError(
-            f"chapter analysed {groups} groups × {post} time points, the prepared cohort "
-            f"has {n_groups} × {n_post}"
+            f"chapter analysed {sorted(groups)} × {post} time points, the prepared cohort "
+            f"has {sorted(manifest['group'].unique())} × {n_post}"
         )
-    expected = n_features * n_post * (3 + n_groups)
-    if tables != 2 * n_features or tests != expected:
-        raise AssertionError(
-            f"chapter computed {tables} tables / {tests} tests, expected "
-            f"{2 * n_features} / {expected}"
-        )
+    expected = n_features * n_post * (3 + len(groups))  # one family of 3, and baseline
+    if tests != expected:
+        raise AssertionError(f"chapter computed {tests} tests, expected {expected}")
     lines = printed(
         nb_path,
         r"(\S+) (\S+): max \|ω_z\(gravity\) − ω·g\| = \S+ °/s; circling index ([-+0-9.]+) /min",
@@ -85,6 +102,42 @@ def check(nb_path: Path, params: dict) -> str:
             f"the feature pipeline {circling:+.3f} /min"
         )
     return (
-        f"{tables} tables, {tests} tests on {groups} groups × {post} time points; "
+        f"{tests} tests on {len(groups)} groups × {post} time points; "
         f"{subject} {timepoint} circling {index} /min (package: {circling:+.3f})"
     )
+
+
+def prepare_foreign(tmp: Path) -> dict:
+    """Two groups of 1-min pieces of a real accelerometer-only tag deployment (NaN gaps
+    kept), one time point, and one damaged session file."""
+    return {
+        **SMALL,
+        "COHORT_MANIFEST": str(foreign_cohort(tmp)),
+        "CONTROL_GROUP": "early",
+        "POWER_N": [3, 4, 6],
+    }
+
+
+def check_foreign(nb_path: Path, params: dict) -> str:
+    """The chapter took the design from the data (two groups with their animals, one
+    time point: between-group tests only), listed the failed session, and ran one
+    comparison per feature."""
+    import pandas as pd
+
+    manifest = pd.read_csv(params["COHORT_MANIFEST"])
+    groups, tests, n_features, post = _design_lines(nb_path)
+    ok = manifest[manifest["session"] != "broken"]
+    expected = ok.groupby("group")["subject"].nunique().to_dict()
+    if groups != expected or post != 1 or tests != n_features:
+        raise AssertionError(
+            f"chapter: groups {groups}, {post} time point(s), {tests} tests; the cohort: "
+            f"{expected}, 1 time point, {n_features} tests"
+        )
+    printed(nb_path, r"between-group tests only", "single time point line")
+    failed = printed(nb_path, r"left out: (.+)", "failed sessions")
+    if "broken" not in failed[0]:
+        raise AssertionError(f"the failed session is not listed: {failed[0]!r}")
+    return f"{groups}, one time point, {tests} tests, failed session listed"
+
+
+VARIANTS = {"foreign": prepare_foreign}

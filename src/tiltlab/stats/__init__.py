@@ -56,7 +56,7 @@ from .nonparametric import (
     signed_rank_p_lattice,
     wilcoxon_signed_rank,
 )
-from .published import FAYAT_TABLES, FAYAT_TIME_POINTS, fayat_table
+from .published import FAYAT_DESIGN, FAYAT_TABLES, FAYAT_TIME_POINTS, fayat_table
 from .power import (
     PowerResult,
     animals_needed,
@@ -80,6 +80,7 @@ __all__ = [
     "design_tables",
     "session_table",
     "study_design",
+    "FAYAT_DESIGN",
     "FAYAT_TABLES",
     "FAYAT_TIME_POINTS",
     "fayat_table",

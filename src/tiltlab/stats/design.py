@@ -186,9 +186,10 @@ class StudyDesign:
             )
         for name, comps in self.families.items():
             pairs = "; ".join(f"{a} vs. {b}" for a, b in comps)
+            n_tp, m = len(self.compared_timepoints), self.family_size(name)
             lines.append(
-                f"family {name!r}: {pairs} × {len(self.compared_timepoints)} time "
-                f"point(s) = {self.family_size(name)} tests per feature"
+                f"family {name!r}: {pairs} × {n_tp} time point{'s' if n_tp != 1 else ''}"
+                f" = {m} test{'s' if m != 1 else ''} per feature"
             )
         if self.failed:
             lines.append(

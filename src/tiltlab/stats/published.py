@@ -16,9 +16,40 @@ from __future__ import annotations
 
 import pandas as pd
 
-__all__ = ["FAYAT_TIME_POINTS", "FAYAT_TABLES", "fayat_table"]
+__all__ = ["FAYAT_DESIGN", "FAYAT_TIME_POINTS", "FAYAT_TABLES", "fayat_table"]
 
 FAYAT_TIME_POINTS: tuple[str, ...] = ("1h", "1d", "2d", "7d", "14d", "28d")
+
+#: Fayat et al.'s analysis design (§2.4, §3.4, Tables A1–A8) as keywords of
+#: :func:`tiltlab.stats.study_design`: the anaesthesia-only control group, one family
+#: per lesion type (lesion vs control, lesion vs its sham, sham vs control) and the
+#: one-sided alternatives of their features (lesioned animals more immobile, less
+#: mobile, tilted toward the lesion, circling), plus ``focus``, the group of their
+#: tilt maps and Fig. A5.
+FAYAT_DESIGN: dict = {
+    "control": "Healthy",
+    "families": {
+        "Arsanilate": [
+            ("Arsanilate", "Healthy"),
+            ("Arsanilate", "ShamArsanilate"),
+            ("ShamArsanilate", "Healthy"),
+        ],
+        "Kainate": [
+            ("Kainate", "Healthy"),
+            ("Kainate", "ShamKainate"),
+            ("ShamKainate", "Healthy"),
+        ],
+    },
+    "directions": {
+        "immobile_fraction": "greater",
+        "immobile_fraction_auto": "greater",
+        "visited_fraction": "less",
+        "visited_fraction_moving": "less",
+        "tilt_immobile_sagittal_deg": "greater",
+        "circling_index": "greater",
+    },
+    "focus": "Arsanilate",
+}
 
 #: Table name → comparison → the six printed p-values (1 h … 28 d).
 FAYAT_TABLES: dict[str, dict[str, tuple[str, ...]]] = {
