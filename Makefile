@@ -36,9 +36,11 @@ lint: env
 test: lint
 	$(PY) -m pytest
 
-# every chapter a second time on another data source / parameter set (papermill)
+# every chapter a second time on another data source / parameter set (papermill), then
+# `tiltlab report` for real on a converted foreign recording and a small cohort
 rerun: env
 	$(PY) tools/rerun_chapters.py
+	$(PY) tools/report_check.py
 
 browser-test: env
 	TILTLAB_REQUIRE_BOOK=1 $(PY) -m pytest -m browser

@@ -395,7 +395,7 @@ def test_cohort_table_says_why_features_are_nan(tmp_path):
     assert "circling_index" in notes[1] and "gyroscope" in notes[1]
     assert notes[1].count("needs a gyroscope") <= 2  # grouped by reason
     text = str(cohort.summary(table))
-    assert "NaN features in s1" in text and "NaN features in s0" not in text
+    assert "NaN features in session s1:" in text and "s0" not in text.split("NaN")[1]
 
 
 def test_realism_table_compares_like_with_like_without_a_gyroscope():

@@ -59,6 +59,7 @@ from .cohort import (
     _cmd_cohort_show,
     _scheduler,
 )
+from .report import _add_report, _cmd_report
 
 __all__ = ["main", "run"]
 
@@ -163,12 +164,22 @@ def _parser() -> argparse.ArgumentParser:
     p_run = csub.add_parser(
         "run",
         help="compute the features of every session of a manifest",
-        description="Compute per-session features for a manifest and write them. Exit "
-        "status 0 if every session succeeded, 1 if any failed (listed on stderr), 2 if "
-        "the manifest or config is rejected.",
+        description="Compute per-session features for a manifest and write them: "
+        "the NetCDF feature file --out (FEATURES.nc) and, beside it, the same table "
+        "for R, Excel and pandas as FEATURES.csv (UTF-8, one row per session; units "
+        "and long names in FEATURES.columns.csv) and FEATURES.parquet (units in its "
+        "field metadata). Exit status 0 if every session succeeded, 1 if any failed "
+        "(listed on stderr; the failed sessions are rows with their error), 2 if the "
+        "manifest or config is rejected.",
     )
     p_run.add_argument("manifest", metavar="MANIFEST")
-    p_run.add_argument("--out", required=True, help="feature file to write (.nc)")
+    p_run.add_argument(
+        "--out",
+        required=True,
+        metavar="FEATURES.nc",
+        help="feature file to write (.nc); FEATURES.csv, FEATURES.columns.csv and "
+        "FEATURES.parquet are written beside it",
+    )
     p_run.add_argument(
         "--workers",
         type=_positive_int("--workers"),
@@ -192,8 +203,17 @@ def _parser() -> argparse.ArgumentParser:
     p_show = csub.add_parser(
         "show",
         help="print a feature file as a table, with its config",
+        description="Print a feature file (FEATURES.nc, from 'cohort run') as a table, "
+        "with its summary and config; --export also writes it as CSV or Parquet.",
     )
     p_show.add_argument("features", metavar="FEATURES.nc")
+    p_show.add_argument(
+        "--export",
+        metavar="TABLE.csv|TABLE.parquet",
+        help="also write the whole feature table, one row per session, as CSV "
+        "(UTF-8; units and long names in TABLE.columns.csv) or Parquet (units in its "
+        "field metadata), for R, Excel and pandas",
+    )
     p_show.add_argument(
         "--max-features",
         type=_positive_int("--max-features"),
@@ -201,6 +221,8 @@ def _parser() -> argparse.ArgumentParser:
         help=f"features shown as columns (default {len(MAIN_FEATURES)}: the main ones)",
     )
     p_show.add_argument("--all", action="store_true", help="every feature")
+
+    _add_report(sub)
     return parser
 
 
@@ -239,6 +261,8 @@ def main(argv: Sequence[str] | None = None) -> int:
                 "run": _cmd_cohort_run,
                 "show": _cmd_cohort_show,
             }[args.cohort_cmd](args)
+        if args.cmd == "report":
+            return _cmd_report(args)
     except UserError as exc:
         if debug:
             raise

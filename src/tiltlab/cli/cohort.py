@@ -113,11 +113,18 @@ def _scheduler(text: str) -> str:
 
 def _cmd_cohort_run(args: argparse.Namespace) -> int:
     from .. import cohort
+    from ..cohort.tables import TABLE_SUFFIXES
 
+    out = Path(args.out)
+    if out.suffix.lower() in TABLE_SUFFIXES:
+        raise UserError(
+            f"--out {out} names the NetCDF feature file: give a file such as "
+            "features.nc (the .csv and .parquet tables are written beside it)",
+            EXIT_REJECTED,
+        )
     manifest, config = _cohort_inputs(args)
     if not args.check_units:
         manifest = _without_unit_check(manifest)
-    out = Path(args.out)
     if out.is_dir():
         raise UserError(
             f"--out {out} is a folder; give a file such as features.nc", EXIT_REJECTED
@@ -135,6 +142,11 @@ def _cmd_cohort_run(args: argparse.Namespace) -> int:
     report = cohort.summary(features)
     print(report)
     print(f"features of {report.n_sessions} session(s) written to {out}")
+    csv, parquet = _save_tables(features, out)
+    print(
+        f"the same table for R, Excel and pandas: {csv} (units and long names in "
+        f"{cohort.sidecar_path(csv)}) and {parquet}"
+    )
     if report.n_failed:
         failed = list(report.failures)
         listed = ", ".join(failed[:10]) + (", ..." if len(failed) > 10 else "")
@@ -145,6 +157,45 @@ def _cmd_cohort_run(args: argparse.Namespace) -> int:
         )
         return EXIT_ERROR
     return EXIT_OK
+
+
+def _save_tables(features, out: Path) -> tuple[Path, Path]:
+    """Write ``<out stem>.csv`` (with its ``.columns.csv``) and ``.parquet`` beside
+    the NetCDF feature file."""
+    from .. import cohort
+
+    table = cohort.to_table(features)
+    return (
+        _export(table, out.with_suffix(".csv")),
+        _export(table, out.with_suffix(".parquet")),
+    )
+
+
+def _export(table, path: Path) -> Path:
+    """:func:`tiltlab.cohort.save_table`, a missing pyarrow reported as a user error."""
+    from .. import cohort
+
+    try:
+        return cohort.save_table(table, path)
+    except ImportError as exc:
+        raise UserError(f"{path}: {exc}") from None
+
+
+def _export_path(text: str) -> Path:
+    """The ``--export`` file of ``cohort show``, checked before any work (exit 2)."""
+    from ..cohort.tables import TABLE_SUFFIXES
+
+    path = Path(text)
+    if path.suffix.lower() not in TABLE_SUFFIXES:
+        raise UserError(
+            f"--export {text}: unknown table format "
+            f"{path.suffix or '(no suffix)'!r}; give a .csv file (units in "
+            "<stem>.columns.csv beside it) or a .parquet file",
+            EXIT_REJECTED,
+        )
+    if path.is_dir():
+        raise UserError(f"--export {text} is a folder; give a file", EXIT_REJECTED)
+    return path
 
 
 #: Features shown first by ``cohort show`` (Fayat et al. 2021's main outcomes).
@@ -196,6 +247,7 @@ def _cmd_cohort_show(args: argparse.Namespace) -> int:
     from .. import cohort
 
     path = Path(args.features)
+    export = None if args.export is None else _export_path(args.export)
     if not path.is_file():
         raise UserError(f"{path}: no such file")
     features = cohort.load_features(path)
@@ -221,6 +273,16 @@ def _cmd_cohort_show(args: argparse.Namespace) -> int:
         width = max(len(k) for k in config)
         for k in sorted(config):
             print(f"  {k:<{width}} = {json.dumps(config[k])}")
+    if export is not None:
+        table = cohort.to_table(features)
+        _export(table, export)
+        n_rows, n_cols = table.shape
+        where = (
+            f" (units and long names in {cohort.sidecar_path(export)})"
+            if export.suffix.lower() == ".csv"
+            else ""
+        )
+        print(f"\nwrote {export}: {n_rows} session(s) x {n_cols} column(s){where}")
     return EXIT_OK
 
 

@@ -14,7 +14,12 @@ r"""Cohorts: from a lab's folder of sessions to one feature table (layer 7).
 * :mod:`~tiltlab.cohort.run` — :func:`run_cohort` (serial, local processes or
   ``dask.distributed``, one code path; a per-session disk cache; failed sessions
   recorded, never lost), :func:`summary`, :func:`save_features`,
-  :func:`load_features`.
+  :func:`load_features`;
+* :mod:`~tiltlab.cohort.tables` — the same feature table for R, Excel and pandas:
+  :func:`to_table` (a tidy DataFrame, one row per session, ids as strings, units in
+  ``df.attrs``), :func:`save_table` (``.csv`` with its units in the sidecar
+  ``<stem>.columns.csv``, or ``.parquet`` with units in the field metadata) and
+  :func:`load_table`.
 
 Example
 -------
@@ -22,6 +27,7 @@ Example
 >>> m = cohort.read_manifest("study/manifest.csv")               # doctest: +SKIP
 >>> feats = cohort.run_cohort(m, cohort.FeatureConfig(), workers=4)  # doctest: +SKIP
 >>> print(cohort.summary(feats))                                 # doctest: +SKIP
+>>> cohort.save_table(feats, "features.csv")                     # doctest: +SKIP
 
 References
 ----------
@@ -53,6 +59,7 @@ from .run import (
     save_features,
     summary,
 )
+from .tables import TABLE_SUFFIXES, load_table, save_table, sidecar_path, to_table
 
 __all__ = [
     "FeatureConfig",
@@ -77,4 +84,9 @@ __all__ = [
     "summary",
     "save_features",
     "load_features",
+    "TABLE_SUFFIXES",
+    "to_table",
+    "save_table",
+    "load_table",
+    "sidecar_path",
 ]

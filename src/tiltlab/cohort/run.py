@@ -25,6 +25,7 @@ import json
 import os
 import sys
 import uuid
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -199,20 +200,32 @@ def _cache_get(cache: Path, key: str | None, names) -> xr.Dataset | None:
     return ds
 
 
-def _atomic_write(text: str, path: Path) -> Path:
-    """Write ``text`` to a temporary file beside ``path``, then rename it into place."""
+def _write_atomically(path, write: Callable[[Path], object]) -> Path:
+    """Call ``write(tmp)`` on a temporary file beside ``path``, then rename it into
+    place (:func:`os.replace`): a reader sees the old file or the new one, never half
+    of one, and a failed ``write`` leaves no temporary file behind."""
+    path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     tmp = path.with_name(f".{path.name}.{os.getpid()}.{uuid.uuid4().hex}.tmp")
     try:
-        with open(tmp, "w") as f:
-            f.write(text)
-            f.flush()
-            os.fsync(f.fileno())
+        write(tmp)
         os.replace(tmp, path)
     finally:
         if tmp.exists():
             tmp.unlink()
     return path
+
+
+def _atomic_write(text: str, path: Path) -> Path:
+    """Write ``text`` to a temporary file beside ``path``, then rename it into place."""
+
+    def write(tmp: Path) -> None:
+        with open(tmp, "w") as f:
+            f.write(text)
+            f.flush()
+            os.fsync(f.fileno())
+
+    return _write_atomically(path, write)
 
 
 def _cache_put(cache: Path, key: str, ds: xr.Dataset) -> Path:
@@ -441,7 +454,13 @@ class CohortSummary:
         if self.n_computed is not None:
             head += f" ({self.n_computed} computed, {self.n_cached} from cache)"
         lines = [head] + [f"  failed {s}: {e}" for s, e in self.failures.items()]
-        lines += [f"  NaN features in {s}: {n}" for s, n in self.notes.items()]
+        by_note: dict[str, list[str]] = {}
+        for session, note in self.notes.items():  # sessions that share a reason
+            by_note.setdefault(note, []).append(session)
+        for note, sessions in by_note.items():
+            shown = ", ".join(sessions[:4]) + (", …" if len(sessions) > 4 else "")
+            count = f"{len(sessions)} sessions" if len(sessions) > 1 else "session"
+            lines.append(f"  NaN features in {count} {shown}: {note}")
         return "\n".join(lines)
 
 
@@ -476,19 +495,10 @@ def summary(features: xr.Dataset) -> CohortSummary:
 
 def save_features(ds: xr.Dataset, path) -> Path:
     """Save a feature table to NetCDF (exact round trip with :func:`load_features`),
-    atomically."""
+    atomically. :func:`~tiltlab.cohort.save_table` writes it as CSV or Parquet."""
     if not isinstance(ds, xr.Dataset):
         raise TypeError(f"expected an xarray.Dataset, got {type(ds).__name__}")
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f".{path.name}.{os.getpid()}.{uuid.uuid4().hex}.tmp")
-    try:
-        _io.save_netcdf(ds, tmp)
-        os.replace(tmp, path)
-    finally:
-        if tmp.exists():
-            tmp.unlink()
-    return path
+    return _write_atomically(path, lambda tmp: _io.save_netcdf(ds, tmp))
 
 
 def load_features(path) -> xr.Dataset:
