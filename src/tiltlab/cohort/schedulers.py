@@ -6,7 +6,8 @@ Every back end offers ``submit(fn, *args)`` → a future with ``result()``,
 * serial — tasks run in this process, one by one, when collected;
 * processes — a :class:`concurrent.futures.ProcessPoolExecutor` whose workers are
   started with ``spawn`` (a script that runs a cohort on processes therefore needs the
-  usual ``if __name__ == "__main__":`` guard);
+  usual ``if __name__ == "__main__":`` guard) and end with their parent, even when it
+  is killed (:func:`exit_with_parent`);
 * dask — a ``dask.distributed`` client: a ``LocalCluster`` started here
   (``"dask"``), an existing scheduler (an address ``"tcp://…"``) or a given
   ``distributed.Client``.
@@ -19,6 +20,9 @@ from __future__ import annotations
 
 import multiprocessing
 import os
+import signal
+import threading
+import time
 import uuid
 from collections.abc import Callable, Iterable, Iterator
 from concurrent.futures import Future, ProcessPoolExecutor
@@ -54,13 +58,44 @@ class _Serial:
         pass
 
 
+def exit_with_parent(parent: int, poll_s: float = 1.0) -> None:
+    """End this (worker) process when ``parent`` dies, even by SIGKILL.
+
+    On Linux the kernel sends SIGTERM at once (``prctl(PR_SET_PDEATHSIG)``); everywhere
+    a daemon thread checks every ``poll_s`` seconds that the parent is still the one
+    that started it, and exits otherwise. Without it a killed ``cohort run`` leaves its
+    pool workers (and so the multiprocessing resource tracker) running.
+    """
+    try:
+        import ctypes
+
+        libc = ctypes.CDLL("libc.so.6", use_errno=True)
+        libc.prctl(1, signal.SIGTERM)  # 1 = PR_SET_PDEATHSIG
+    except (OSError, AttributeError):  # not Linux: the thread below does it
+        pass
+    if os.getppid() != parent:  # the parent died before prctl took effect
+        os._exit(1)
+
+    def watch() -> None:
+        while True:
+            time.sleep(poll_s)
+            if os.getppid() != parent:
+                os._exit(1)
+
+    threading.Thread(target=watch, name="tiltlab-exit-with-parent", daemon=True).start()
+
+
 class _Processes:
     name = "processes"
 
     def __init__(self, workers: int):
-        # spawn, not fork: numba's OpenMP threads make fork() unsafe once a kernel ran
+        # spawn, not fork: numba's OpenMP threads make fork() unsafe once a kernel ran;
+        # the workers end with this process, however it ends
         self.pool = ProcessPoolExecutor(
-            max_workers=workers, mp_context=multiprocessing.get_context("spawn")
+            max_workers=workers,
+            mp_context=multiprocessing.get_context("spawn"),
+            initializer=exit_with_parent,
+            initargs=(os.getpid(),),
         )
 
     def submit(self, fn, *args) -> Future:
