@@ -246,23 +246,23 @@ def main(argv: Sequence[str] | None = None) -> int:
     except SystemExit as exc:  # usage errors and --help: argparse has printed them
         return exc.code if isinstance(exc.code, int) else EXIT_REJECTED
     debug = os.environ.get("TILTLAB_DEBUG", "") not in ("", "0")
+    commands = {
+        "fetch": lambda: _cmd_fetch(args, parser),
+        "info": lambda: _cmd_info(args),
+        "validate": lambda: _cmd_validate(args),
+        "convert": lambda: _cmd_convert(args),
+        "cohort": lambda: {
+            "init": _cmd_cohort_init,
+            "run": _cmd_cohort_run,
+            "show": _cmd_cohort_show,
+        }[args.cohort_cmd](args),
+        "report": lambda: _cmd_report(args),
+    }
     try:
-        if args.cmd == "fetch":
-            return _cmd_fetch(args, parser)
-        if args.cmd == "info":
-            return _cmd_info(args)
-        if args.cmd == "validate":
-            return _cmd_validate(args)
-        if args.cmd == "convert":
-            return _cmd_convert(args)
-        if args.cmd == "cohort":
-            return {
-                "init": _cmd_cohort_init,
-                "run": _cmd_cohort_run,
-                "show": _cmd_cohort_show,
-            }[args.cohort_cmd](args)
-        if args.cmd == "report":
-            return _cmd_report(args)
+        if args.cmd in commands:
+            status = commands[args.cmd]()
+            sys.stdout.flush()  # a closed pipe shows here, not at interpreter exit
+            return status
     except UserError as exc:
         if debug:
             raise
@@ -271,6 +271,12 @@ def main(argv: Sequence[str] | None = None) -> int:
     except KeyboardInterrupt:
         print("tiltlab: interrupted", file=sys.stderr)
         return 130
+    except BrokenPipeError:
+        # the reader closed the pipe (`tiltlab cohort show f.nc | head`): stop quietly,
+        # and keep Python from complaining when it flushes stdout at exit
+        with contextlib.suppress(OSError, ValueError):
+            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 0
     except Exception as exc:
         if debug:
             raise
