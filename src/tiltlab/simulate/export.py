@@ -49,7 +49,7 @@ def phone_export(
     its own start, Gaussian jitter), its values linearly interpolated from the
     Recording at those times, and is written with columns ``time`` (integer
     nanoseconds since the Unix epoch, from ``start_ns``), ``seconds_elapsed`` (s since
-    the first sample of all streams) and ``z``, ``y``, ``x`` (the axis order of some
+    the Recording's first sample, to the microsecond) and ``z``, ``y``, ``x`` (the axis order of some
     phone apps), in the phone's units (m/s², rad/s, µT). The axes are written as they
     are: a simulated recording in the sensor frame becomes a phone whose (right, top,
     out of screen) axes are the sensor's (x, y, z). It is a test input for
@@ -111,7 +111,7 @@ def phone_export(
         table = pd.DataFrame(
             {
                 "time": start_ns + np.round((times - t0) * 1e9).astype(np.int64),
-                "seconds_elapsed": times - t0,
+                "seconds_elapsed": np.round(times - t0, 6),  # µs, as apps print it
             }
         )
         for k, axis in ((2, "z"), (1, "y"), (0, "x")):
