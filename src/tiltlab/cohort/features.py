@@ -204,8 +204,10 @@ def _tumble(cal, config: FeatureConfig):
     )
 
 
-def _corrected(rec: xr.Dataset, config: FeatureConfig, calibration):
-    """Calibrated Recording and the session gyro offset removed (°/s)."""
+def _corrected(rec: xr.Dataset, config: FeatureConfig, calibration, notes=None):
+    """Calibrated Recording and the session gyro offset removed (°/s; NaN when it
+    could not be estimated, e.g. sustained rotation throughout: then nothing is
+    removed and ``notes`` gets the reason)."""
     stacked = False
     if calibration is not None:
         cal = _tumble(calibration, config)
@@ -213,7 +215,12 @@ def _corrected(rec: xr.Dataset, config: FeatureConfig, calibration):
         stacked = "gyr_offset" in cal.corrects()
     off = np.zeros(3)
     if config.gyr_offset == "auto" and "gyr" in rec:
-        raw = np.asarray(_calibration.robust_gyro_offset(rec), float)
+        try:
+            raw = np.asarray(_calibration.robust_gyro_offset(rec), float)
+        except _calibration.CalibrationError as exc:
+            if notes is not None:
+                notes.append(f"gyroscope offset not removed: {exc}")
+            return rec, np.full(3, np.nan)
         off = raw * _units.conversion_factor(rec["gyr"].attrs["units"], "deg/s")
         rec = _calibration.calibrate(
             rec,
@@ -371,7 +378,8 @@ def session_features(
         )
     _schema.validate(recording, allow_nan=True, check_units=check_units)
     has_gyr = "gyr" in recording
-    rec, off = _corrected(recording, config, calibration)
+    offset_notes: list[str] = []
+    rec, off = _corrected(recording, config, calibration, offset_notes)
     fs = float(rec.attrs["fs"])
     n = rec.sizes["time"]
     if n < 2 * fs:
@@ -389,10 +397,12 @@ def session_features(
     out: dict[str, float] = {"duration_s": n / fs}
     offset_keys = [f"gyr_offset_{a}" for a in "xyz"]
     speed_keys = [k for k in spec if k.startswith("angular_speed_moving_q")]
-    if has_gyr:
-        out.update({k: float(o) for k, o in zip(offset_keys, off)})
-    else:
+    if not has_gyr:
         undefined(offset_keys, NO_GYRO)
+    elif offset_notes:
+        undefined(offset_keys, offset_notes[0])
+    else:
+        out.update({k: float(o) for k, o in zip(offset_keys, off)})
 
     method, _, _ = _tilt_method(rec, config)
     g = _tilt(rec, config)
