@@ -75,9 +75,47 @@ One module per method family — :mod:`~tiltlab.filters.lowpass`,
 supports a magnetometer, and its parameter defaults, read from the function's
 signature: the one place they are written) and :mod:`~tiltlab.filters.recordings`
 (:func:`estimate`, :func:`gravity`). The array functions take SI inputs (``acc`` m/s²
-or any unit where only its direction matters, ``gyr`` rad/s) and a mandatory ``fs``;
-durations end in ``_s``, frequencies in ``_hz``. Scoring against references
-(``broad_errors``, ``tilt_rmse``, ``grid_search``) lives in :mod:`tiltlab.evaluate`.
+or any unit where only its direction matters, ``gyr`` rad/s) and a mandatory ``fs``,
+or labelled inputs (below); durations end in ``_s``, frequencies in ``_hz``. Scoring
+against references (``broad_errors``, ``tilt_rmse``, ``grid_search``) lives in
+:mod:`tiltlab.evaluate`.
+
+Labelled inputs
+---------------
+Every array function (the filters, :func:`lowpass_tilt`, :func:`rest_gyro_bias`,
+:func:`davenport`, :func:`magnetic_dip`, :func:`vector_observation` and the adapters)
+also takes labelled :class:`xarray.DataArray` inputs, such as a Recording's own
+``rec["acc"]`` and ``rec["gyr"]``, and honours their attributes as
+:func:`tiltlab._validate.signal` reads them (the policy of :mod:`tiltlab.behavior` and
+:mod:`tiltlab.sphere`). They are converted once, on entry, to the plain arrays the
+kernels use, so ``madgwick(rec["acc"], rec["gyr"], rec.attrs["fs"])`` gives exactly
+``estimate(rec, "madgwick")``:
+
+* ``gyr``: converted from its ``units`` attribute (``"deg/s"``, ``"rad/s"``, …) to
+  rad/s; a labelled ``gyr`` without ``units`` is a
+  :class:`~tiltlab._validate.RecordingError` (its unit matters);
+* ``acc``: converted from its ``units`` (``"g"``, ``"m/s^2"``) to m/s², which leaves
+  its direction as it is; without ``units`` it is accepted as is by the methods that
+  use only its direction (``madgwick``, ``mahony``, ``ekf``, ``complementary``,
+  ``lowpass_tilt``, ``davenport``, ``magnetic_dip``, ``vector_observation``) and
+  refused by those that use m/s² (``eskf``, ``smoother``, ``rts_smoother``,
+  ``rest_gyro_bias``, the adapters);
+* ``mag``: kept as it is (only its direction is used); a ``units`` attribute must be
+  a magnetic-field unit;
+* a unit of the wrong quantity (``acc`` in ``"deg/s"``) or an unknown one is a
+  :class:`~tiltlab.units.UnitsError` naming the input;
+* ``fs``: an ``fs`` argument that contradicts an input's ``attrs["fs"]`` is refused
+  (the message gives both rates), as are inputs whose ``fs`` attributes disagree; the
+  argument may be omitted when the inputs carry ``attrs["fs"]`` (plain arrays still
+  need it: tiltlab never assumes a rate); a ``time`` coordinate must agree with the
+  rate;
+* ``time`` coordinates of different lengths, or more than half a sample apart, are
+  refused.
+
+Each input is read on its own: a plain array keeps its documented unit even next to a
+labelled one. Plain arrays behave exactly as before, and the outputs are plain arrays
+in every case (:func:`estimate` labels its output). Initial states given as arguments
+(``b0``, ``bias``) and bias outputs stay in rad/s.
 
 Sample indexing
 ---------------

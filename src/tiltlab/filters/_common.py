@@ -1,24 +1,32 @@
 """Shared pieces of the orientation filters: input checks, the initial orientation,
 the minimal tilt quaternion and ``q0`` handling.
 
-Every filter function reads its arrays through :func:`sensor_inputs` and its numeric
-parameters through :mod:`tiltlab._validate`, so that the same mistake gives the same
-message in every method.
+Every filter function reads its arrays through :func:`read_sensors` (or
+:func:`unlabel` then :func:`samples`) and its numeric parameters through
+:mod:`tiltlab._validate`, so that the same mistake gives the same message in every
+method, and labelled inputs (DataArrays with ``units`` and ``fs`` attributes) are
+honoured the same way in every method: :func:`unlabel` converts them once, at entry,
+to the plain arrays in the units the kernels use.
 """
 
 from __future__ import annotations
 
 import numpy as np
+import xarray as xr
 
 from .. import _validate as _v
 from .. import quaternion as quat
+from .. import units as _units
 
 __all__ = [
     "initial_orientation",
+    "is_labelled",
+    "read_sensors",
     "tilt_quaternion",
     "samples",
     "sensor_inputs",
     "start_orientation",
+    "unlabel",
 ]
 
 
@@ -65,10 +73,11 @@ MAX_GYR_RAD_S = 1.0e4
 def sensor_inputs(acc, gyr, mag=None):
     """``(acc, gyr, mag_or_dummy, use_mag)`` as contiguous (N, 3) arrays for the kernels.
 
-    Every filter and adapter reads its arrays here (or through :func:`samples`), so
-    that they all refuse the same inputs: empty arrays, non-finite samples, mismatched
-    lengths, an ``acc`` (or a given ``mag``) that is zero in every sample, and angular
-    rates above :data:`MAX_GYR_RAD_S`.
+    Plain arrays (labelled ones are read first by :func:`unlabel`: see
+    :func:`read_sensors`). Every filter and adapter reads its arrays here (or through
+    :func:`samples`), so that they all refuse the same inputs: empty arrays, non-finite
+    samples, mismatched lengths, an ``acc`` (or a given ``mag``) that is zero in every
+    sample, and angular rates above :data:`MAX_GYR_RAD_S`.
     Without a magnetometer, a (1, 3) zero array stands in for ``mag`` (the kernels take
     an array in every case) and ``use_mag`` is False.
     """
@@ -83,6 +92,18 @@ def sensor_inputs(acc, gyr, mag=None):
     if mag is None:
         return acc, gyr, np.zeros((1, 3)), False
     return acc, gyr, samples(mag, "mag", acc.shape[0], nonzero=True), True
+
+
+def read_sensors(fs, acc, gyr, mag=None, *, acc_si: bool = False):
+    """``(fs, acc, gyr, mag_or_dummy, use_mag)`` for the kernels, labels honoured.
+
+    :func:`unlabel` (labelled inputs: units converted to m/s² and rad/s, ``fs`` read
+    and cross-checked) followed by :func:`sensor_inputs` (shape, finiteness, length
+    and range checks). Plain arrays give exactly what ``check_fs`` and
+    :func:`sensor_inputs` gave before labels were read.
+    """
+    fs, acc, gyr, mag = unlabel(fs, acc=acc, gyr=gyr, mag=mag, acc_si=acc_si)
+    return (fs, *sensor_inputs(acc, gyr, mag))
 
 
 def init_samples(init_window_s: float, fs: float) -> int:
@@ -162,3 +183,206 @@ def initial_orientation(acc, mag=None) -> np.ndarray:
     east /= en
     north = np.cross(up, east)
     return quat.from_matrix(np.stack([east, north, up]))
+
+
+# --------------------------------------------------------------------------- labels
+
+#: the unit each sensor is converted to when its input is labelled (``None``: kept as
+#: it is, after checking that its unit measures the right quantity)
+_LABEL_UNITS = {"acc": "m/s^2", "gyr": "rad/s", "mag": None}
+_QUANTITY = {
+    "acc": "acceleration",
+    "gyr": "angular_velocity",
+    "mag": "magnetic_field",
+}
+_UNIT_HINT = {"acc": "'g' or 'm/s^2'", "gyr": "'deg/s' or 'rad/s'", "mag": "'uT'"}
+_PLAIN_UNIT = {"acc": "m/s²", "gyr": "rad/s", "mag": "any unit"}
+
+
+def is_labelled(a) -> bool:
+    """Whether ``a`` carries labels (an :class:`xarray.DataArray` or a Recording)."""
+    return isinstance(a, (xr.DataArray, xr.Dataset))
+
+
+def _own_attr(a, name: str, key: str):
+    if isinstance(a, xr.Dataset):
+        if key == "fs":
+            return a.attrs.get("fs")
+        return a[name].attrs.get(key) if name in a else None
+    return a.attrs.get(key)
+
+
+def _read_labelled(a, name: str, fs: float | None, acc_si: bool) -> _v.Signal:
+    if isinstance(a, xr.Dataset) and name not in a:
+        raise _v.RecordingError(
+            f"the Recording has no variable {name!r} (needed for {name})"
+        )
+    units = _own_attr(a, name, "units")
+    if units is None and (name == "gyr" or (name == "acc" and acc_si)):
+        why = (
+            "the angular velocity must be converted to rad/s"
+            if name == "gyr"
+            else "this method uses the specific force in m/s² (not only its direction)"
+        )
+        raise _v.RecordingError(
+            f"{name}: the labelled input has no 'units' attribute and {why}: add "
+            f"attrs['units'] ({_UNIT_HINT[name]}), or pass plain values in "
+            f"{_PLAIN_UNIT[name]}"
+        )
+    to = _LABEL_UNITS[name] if units is not None else None
+    own_fs = _own_attr(a, name, "fs")
+    if own_fs is None and fs is not None:
+        _time_agrees(a, name, fs)
+    try:
+        sig = _v.signal(
+            a,
+            name,
+            fs=fs if own_fs is not None else None,
+            to_units=to,
+            need_fs=False,
+            width=3,
+            ndim=None,
+            allow_nan=True,
+        )
+        if sig.units is not None and _units.quantity_of(sig.units) != _QUANTITY[name]:
+            raise _units.UnitsError(
+                f"units {units!r} are not a unit of {_QUANTITY[name].replace('_', ' ')}"
+                f" ({_UNIT_HINT[name]})"
+            )
+    except _units.UnitsError as e:
+        msg = str(e)
+        raise _units.UnitsError(
+            msg if msg.startswith(f"{name}:") else f"{name}: {msg}"
+        ) from None
+    return sig
+
+
+def _time_agrees(a, name: str, fs: float) -> None:
+    """Refuse an ``fs`` argument that contradicts the ``time`` coordinate of a labelled
+    input without an ``fs`` attribute (as :func:`tiltlab._validate.signal` does for the
+    attribute)."""
+    da = a[name] if isinstance(a, xr.Dataset) and name in a else a
+    if not isinstance(da, xr.DataArray) or "time" not in da.coords:
+        return
+    t = da.coords["time"]
+    if t.ndim != 1 or t.size < 3:
+        return
+    med = float(np.median(np.diff(np.asarray(t.values, dtype=float))))
+    if not np.isfinite(med) or med <= 0:
+        raise _v.RecordingError(f"{name}: the time coordinate is not increasing")
+    if abs(med * fs - 1.0) > 0.01:
+        raise _v.RecordingError(
+            f"{name}: fs = {fs:g} Hz contradicts its time coordinate (median step "
+            f"{med:.6g} s, i.e. {1.0 / med:.6g} Hz)"
+        )
+
+
+def _same_rate(rates: dict[str, float]) -> float | None:
+    """The one sampling rate of ``rates`` (by input name); disagreeing ones are refused."""
+    if not rates:
+        return None
+    (first, f0), *rest = rates.items()
+    for name, f in rest:
+        if not np.isclose(f, f0, rtol=1e-9, atol=0.0):
+            raise _v.RecordingError(
+                f"{first} and {name} disagree on the sampling rate: {first} has "
+                f"attribute fs = {f0:g} Hz, {name} has fs = {f:g} Hz (resample one of "
+                "them first)"
+            )
+    return f0
+
+
+def _same_time(signals: dict[str, _v.Signal], fs: float | None) -> None:
+    """Refuse labelled inputs whose ``time`` coordinates differ in length or values."""
+    timed = [(n, s.time) for n, s in signals.items() if s.time is not None]
+    if len(timed) < 2:
+        return
+    n0, t0 = timed[0]
+    for name, t in timed[1:]:
+        if t.shape != t0.shape:
+            raise _v.RecordingError(
+                f"{n0} and {name} have time coordinates of different lengths "
+                f"({t0.size} and {t.size} samples): they are not the same recording"
+            )
+        if t.size == 0:
+            continue
+        if fs is not None:
+            tol = 0.5 / fs
+        elif t0.size > 1:
+            tol = 0.5 * float(np.median(np.diff(t0)))
+        else:
+            tol = 0.0
+        d = float(np.max(np.abs(t - t0)))
+        if not d <= tol:
+            raise _v.RecordingError(
+                f"the time coordinates of {n0} and {name} disagree by up to {d:.6g} s "
+                f"(more than half a sample): their samples are not aligned"
+            )
+
+
+def unlabel(
+    fs,
+    *,
+    acc,
+    gyr=None,
+    mag=None,
+    acc_si: bool = False,
+    need_fs: bool = True,
+):
+    """Read the labels of the filters' inputs once: ``(fs, acc, gyr, mag)``.
+
+    Plain arrays are returned as they are (the same objects; their checks follow in
+    :func:`samples` / :func:`sensor_inputs`), and ``fs`` is then checked by
+    :func:`tiltlab._validate.check_fs` exactly as before. A labelled input (an
+    :class:`xarray.DataArray`, or a Recording read as its variable of that name) is
+    read by :func:`tiltlab._validate.signal` into a new float array:
+
+    * ``gyr`` is converted from its ``units`` attribute to rad/s (required: a labelled
+      ``gyr`` without units is refused);
+    * ``acc`` with a ``units`` attribute is converted to m/s²; without one it is
+      accepted as is where only its direction matters, and refused where the method
+      uses m/s² (``acc_si``);
+    * ``mag`` keeps its values; a ``units`` attribute must be a magnetic-field unit;
+    * ``fs``: an ``fs`` argument contradicting an input's ``attrs["fs"]`` is refused
+      (both values in the message), as are inputs whose ``fs`` attributes disagree;
+      without the argument the attributes give it; a ``time`` coordinate must agree
+      with it (:func:`tiltlab._validate.signal`);
+    * ``time`` coordinates of different lengths, or more than half a sample apart, are
+      refused.
+
+    Each input is read on its own: a plain array next to a labelled one keeps its
+    documented unit. ``need_fs=False`` (functions without a sampling rate) returns the
+    rate found, or ``None``. The conversion is one vectorised multiplication per input,
+    before any kernel runs.
+    """
+    given = {"acc": acc, "gyr": gyr, "mag": mag}
+    labelled = {n: a for n, a in given.items() if a is not None and is_labelled(a)}
+    if not labelled:
+        return (_v.check_fs(fs) if need_fs else fs), acc, gyr, mag
+    own = {
+        n: _v.check_fs(f, name=f"{n} attribute fs")
+        for n, a in labelled.items()
+        if (f := _own_attr(a, n, "fs")) is not None
+    }
+    f_own = _same_rate(own)
+    if fs is not None:
+        f = _v.check_fs(fs)
+        for name, fa in own.items():
+            if not np.isclose(f, fa, rtol=1e-9, atol=0.0):
+                raise _v.RecordingError(
+                    f"{name}: fs = {fs!r} contradicts the data's attribute fs = "
+                    f"{fa:g} Hz"
+                )
+    elif f_own is not None:
+        f = f_own
+    elif need_fs:
+        raise _v.RecordingError(
+            "fs (sampling rate, Hz) is unknown: pass fs= or give the inputs an "
+            "attrs['fs']; tiltlab never assumes a default"
+        )
+    else:
+        f = None
+    signals = {n: _read_labelled(a, n, f, acc_si) for n, a in labelled.items()}
+    _same_time(signals, f)
+    out = {n: (signals[n].values if n in signals else a) for n, a in given.items()}
+    return f, out["acc"], out["gyr"], out["mag"]

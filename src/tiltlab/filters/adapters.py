@@ -5,7 +5,9 @@ Weber, Gühmann & Seel 2021).
 
 Each adapter takes the filters' inputs — ``acc`` in m/s², ``gyr`` in rad/s, ``fs`` in
 Hz, optional ``mag`` — and returns (N, 4) scalar-first quaternions sensor → world with
-world z up. The packages are optional (extra ``compare``; ``riann`` and
+world z up. Labelled DataArrays are read as by the filters (:mod:`tiltlab.filters`,
+"Labelled inputs"): ``acc`` and ``gyr`` are converted from their ``units`` attributes
+(required) and ``fs`` may come from their attributes. The packages are optional (extra ``compare``; ``riann`` and
 ``onnxruntime``: extra ``learn``) and imported on first use.
 """
 
@@ -15,7 +17,13 @@ import numpy as np
 
 from .. import _validate as _v
 from .. import units as _units
-from ._common import init_samples, initial_orientation, sensor_inputs
+from ._common import (
+    init_samples,
+    initial_orientation,
+    read_sensors,
+    sensor_inputs,
+    unlabel,
+)
 
 __all__ = [
     "vqf_parameter_names",
@@ -39,8 +47,7 @@ def vqf_parameter_names() -> frozenset[str]:
 def _vqf(acc, gyr, fs, mag, offline: bool, params: dict) -> np.ndarray:
     import vqf
 
-    fs = _v.check_fs(fs)
-    a, g, m, use_mag = sensor_inputs(acc, gyr, mag)
+    fs, a, g, m, use_mag = read_sensors(fs, acc, gyr, mag, acc_si=True)
     unknown = sorted(set(params) - vqf_parameter_names())
     if unknown:
         raise ValueError(
@@ -55,13 +62,15 @@ def _vqf(acc, gyr, fs, mag, offline: bool, params: dict) -> np.ndarray:
     return np.asarray(res["quat9D" if use_mag else "quat6D"])
 
 
-def run_vqf(acc, gyr, fs: float, *, mag=None, **vqf_params) -> np.ndarray:
+def run_vqf(acc, gyr, fs: float | None = None, *, mag=None, **vqf_params) -> np.ndarray:
     """VQF (``vqf.VQF(...).updateBatch``), 6D or 9D; ``vqf_params`` are the ``vqf``
     package's own parameters with its own defaults (e.g. ``tauAcc`` in s)."""
     return _vqf(acc, gyr, fs, mag, False, vqf_params)
 
 
-def run_offline_vqf(acc, gyr, fs: float, *, mag=None, **vqf_params) -> np.ndarray:
+def run_offline_vqf(
+    acc, gyr, fs: float | None = None, *, mag=None, **vqf_params
+) -> np.ndarray:
     """offlineVQF (``vqf.offlineVQF``, non-causal), 6D or 9D; ``vqf_params`` as for
     :func:`run_vqf`."""
     return _vqf(acc, gyr, fs, mag, True, vqf_params)
@@ -70,7 +79,7 @@ def run_offline_vqf(acc, gyr, fs: float, *, mag=None, **vqf_params) -> np.ndarra
 def run_imufusion(
     acc,
     gyr,
-    fs: float,
+    fs: float | None = None,
     *,
     gain: float = 0.5,
     acceleration_rejection_deg: float = 10.0,
@@ -84,8 +93,7 @@ def run_imufusion(
     """
     import imufusion
 
-    fs = _v.check_fs(fs)
-    acc, gyr, _, _ = sensor_inputs(acc, gyr)
+    fs, acc, gyr, _, _ = read_sensors(fs, acc, gyr, acc_si=True)
     gain = _v.nonnegative(gain, "gain")
     rej = _v.nonnegative(acceleration_rejection_deg, "acceleration_rejection_deg")
     timeout = _v.nonnegative(rejection_timeout_s, "rejection_timeout_s")
@@ -111,14 +119,13 @@ def run_imufusion(
 
 
 def _ahrs_start(acc, gyr, fs, init_window_s):
-    fs = _v.check_fs(fs)
-    acc, gyr, _, _ = sensor_inputs(acc, gyr)
+    fs, acc, gyr, _, _ = read_sensors(fs, acc, gyr, acc_si=True)
     q0 = initial_orientation(acc[: init_samples(init_window_s, fs)])
     return acc, gyr, fs, q0
 
 
 def run_ahrs_madgwick(
-    acc, gyr, fs: float, *, beta: float = 0.05, init_window_s: float = 0.1
+    acc, gyr, fs: float | None = None, *, beta: float = 0.05, init_window_s: float = 0.1
 ) -> np.ndarray:
     """``ahrs.filters.Madgwick`` (6D) with an explicit ``frequency``, started at
     :func:`initial_orientation` of the first ``init_window_s`` seconds."""
@@ -133,7 +140,7 @@ def run_ahrs_madgwick(
 def run_ahrs_mahony(
     acc,
     gyr,
-    fs: float,
+    fs: float | None = None,
     *,
     kp: float = 1.0,
     ki: float = 0.3,
@@ -156,7 +163,7 @@ def run_ahrs_mahony(
 def run_ahrs_ekf(
     acc,
     gyr,
-    fs: float,
+    fs: float | None = None,
     *,
     var_gyr: float = 0.3**2,
     var_acc: float = 0.5**2,
@@ -180,18 +187,19 @@ def run_ahrs_ekf(
 RIANN_CHUNK = 50_000
 
 
-def run_riann(acc, gyr, fs: float, *, mag=None) -> np.ndarray:
+def run_riann(acc, gyr, fs: float | None = None, *, mag=None) -> np.ndarray:
     """RIANN, a published recurrent network for attitude estimation (``riann``), 6D.
 
     Parameters
     ----------
-    acc : array_like, shape (N, 3)
-        Specific force, m/s².
-    gyr : array_like, shape (N, 3)
-        Angular rate, rad/s.
-    fs : float
-        Sampling rate, Hz (mandatory; the network takes the sampling interval as an
-        input, so any rate is accepted).
+    acc : array_like or xarray.DataArray, shape (N, 3)
+        Specific force, m/s² (a labelled DataArray: converted from its ``units``).
+    gyr : array_like or xarray.DataArray, shape (N, 3)
+        Angular rate, rad/s (a labelled DataArray: converted from its ``units``).
+    fs : float, optional
+        Sampling rate, Hz (mandatory for plain arrays; labelled inputs may carry it
+        as ``attrs["fs"]``; the network takes the sampling interval as an input, so
+        any rate is accepted).
     mag : None
         Present for the adapters' uniform signature only: RIANN is a 6D method, and any
         ``mag`` other than None is a ValueError.
@@ -238,7 +246,7 @@ def run_riann(acc, gyr, fs: float, *, mag=None) -> np.ndarray:
             "extra (pip install tiltlab[learn])"
         ) from e
 
-    fs = _v.check_fs(fs)
+    fs, acc, gyr, _ = unlabel(fs, acc=acc, gyr=gyr, acc_si=True)
     if mag is not None:
         raise ValueError(
             "RIANN is a 6D method (accelerometer and gyroscope) and takes no "

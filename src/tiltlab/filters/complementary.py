@@ -7,7 +7,7 @@ from numba import njit
 
 from .. import _validate as _v
 from ..quaternion import qmul_scalar, rotate_scalar, zoh_step_scalar
-from ._common import sensor_inputs, start_orientation
+from ._common import read_sensors, start_orientation
 
 __all__ = ["complementary"]
 
@@ -51,7 +51,7 @@ def _complementary_kernel(acc, gyr, mag, use_mag, dt, k_acc, k_mag, q0, out):
 def complementary(
     acc,
     gyr,
-    fs: float,
+    fs: float | None = None,
     *,
     mag=None,
     tau_acc_s: float = 1.0,
@@ -72,12 +72,17 @@ def complementary(
 
     Parameters
     ----------
-    acc, gyr : array_like, shape (N, 3)
+    acc, gyr : array_like or xarray.DataArray, shape (N, 3)
         Specific force (any unit) and angular velocity (rad/s).
-    fs : float
-        Sampling rate (Hz), mandatory.
-    mag : array_like, shape (N, 3), optional
-        Magnetometer (any unit): 9D, ENU world frame.
+        Labelled inputs (:class:`xarray.DataArray`) are read by their attributes:
+        ``gyr`` is converted from its ``units`` (required) to rad/s, ``acc`` with
+        ``units`` to m/s² (see :mod:`tiltlab.filters`, "Labelled inputs").
+    fs : float, optional
+        Sampling rate (Hz): mandatory for plain arrays; with labelled inputs it may
+        be omitted when they carry ``attrs["fs"]``, and must agree with it when given.
+    mag : array_like or xarray.DataArray, shape (N, 3), optional
+        Magnetometer (any unit; a ``units`` attribute must be a magnetic-field unit):
+        9D, ENU world frame.
     tau_acc_s, tau_mag_s : float
         Time constants (s) of the accelerometer and magnetometer corrections; ``inf``
         disables a correction.
@@ -91,8 +96,7 @@ def complementary(
     -------
     numpy.ndarray, shape (N, 4)
     """
-    fs = _v.check_fs(fs)
-    acc, gyr, m, use_mag = sensor_inputs(acc, gyr, mag)
+    fs, acc, gyr, m, use_mag = read_sensors(fs, acc, gyr, mag)
     dt = 1.0 / fs
     k_acc = -np.expm1(-dt / _v.positive(tau_acc_s, "tau_acc_s", allow_inf=True))
     k_mag = -np.expm1(-dt / _v.positive(tau_mag_s, "tau_mag_s", allow_inf=True))

@@ -11,7 +11,7 @@ from numba import njit
 
 from .. import _validate as _v
 from ..quaternion import qmul_scalar, rotate_scalar
-from ._common import init_samples, sensor_inputs, start_orientation
+from ._common import init_samples, read_sensors, start_orientation
 
 __all__ = ["ekf"]
 
@@ -211,7 +211,7 @@ def _dip_from(acc, mag) -> float:
 def ekf(
     acc,
     gyr,
-    fs: float,
+    fs: float | None = None,
     *,
     mag=None,
     var_gyr: float = 0.3**2,
@@ -242,12 +242,17 @@ def ekf(
 
     Parameters
     ----------
-    acc, gyr : array_like, shape (N, 3)
+    acc, gyr : array_like or xarray.DataArray, shape (N, 3)
         Specific force (any unit) and angular velocity (rad/s).
-    fs : float
-        Sampling rate (Hz), mandatory.
-    mag : array_like, shape (N, 3), optional
-        Magnetometer (any unit): 9D, ENU world frame.
+        Labelled inputs (:class:`xarray.DataArray`) are read by their attributes:
+        ``gyr`` is converted from its ``units`` (required) to rad/s, ``acc`` with
+        ``units`` to m/s² (see :mod:`tiltlab.filters`, "Labelled inputs").
+    fs : float, optional
+        Sampling rate (Hz): mandatory for plain arrays; with labelled inputs it may
+        be omitted when they carry ``attrs["fs"]``, and must agree with it when given.
+    mag : array_like or xarray.DataArray, shape (N, 3), optional
+        Magnetometer (any unit; a ``units`` attribute must be a magnetic-field unit):
+        9D, ENU world frame.
     var_gyr, var_acc, var_mag : float
         Gyroscope noise variance ((rad/s)², ``>= 0``) and measurement variances (``> 0``)
         of the unit accelerometer and magnetometer directions.
@@ -261,9 +266,12 @@ def ekf(
         ``init_window_s`` seconds.
     init_window_s : float
         Initialisation window (s).
+
+    Returns
+    -------
+    numpy.ndarray, shape (N, 4)
     """
-    fs = _v.check_fs(fs)
-    acc, gyr, m, use_mag = sensor_inputs(acc, gyr, mag)
+    fs, acc, gyr, m, use_mag = read_sensors(fs, acc, gyr, mag)
     var_gyr = _v.nonnegative(var_gyr, "var_gyr")
     var_acc = _v.positive(var_acc, "var_acc")
     var_mag = _v.positive(var_mag, "var_mag")

@@ -18,7 +18,7 @@ from ..quaternion import (
     rotvec_to_quat_scalar,
     zoh_step_scalar,
 )
-from ._common import sensor_inputs, start_orientation
+from ._common import read_sensors, start_orientation
 
 __all__ = ["eskf"]
 
@@ -203,7 +203,7 @@ def _eskf_kernel(
 def eskf(
     acc,
     gyr,
-    fs: float,
+    fs: float | None = None,
     *,
     mag=None,
     gyr_noise: float = 5e-3,
@@ -227,16 +227,22 @@ def eskf(
 
     Parameters
     ----------
-    acc : array_like, shape (N, 3)
+    acc : array_like or xarray.DataArray, shape (N, 3)
         Specific force in **m/s²** (its direction is the measurement; its norm drives the
-        adaptive variance against standard gravity 9.80665 m/s²).
-    gyr : array_like, shape (N, 3)
-        Angular velocity (rad/s).
-    fs : float
-        Sampling rate (Hz), mandatory.
-    mag : array_like, shape (N, 3), optional
-        Magnetometer (any unit): 9D with a heading-only update, ENU world frame
-        (x east, y magnetic north, z up).
+        adaptive variance against standard gravity 9.80665 m/s²). A labelled
+        DataArray is converted from its ``units`` attribute (required: e.g. ``"g"``)
+        to m/s².
+    gyr : array_like or xarray.DataArray, shape (N, 3)
+        Angular velocity (rad/s). A labelled DataArray is converted from its
+        ``units`` attribute (required: e.g. ``"deg/s"``) to rad/s (see
+        :mod:`tiltlab.filters`, "Labelled inputs").
+    fs : float, optional
+        Sampling rate (Hz): mandatory for plain arrays; with labelled inputs it may
+        be omitted when they carry ``attrs["fs"]``, and must agree with it when given.
+    mag : array_like or xarray.DataArray, shape (N, 3), optional
+        Magnetometer (any unit; a ``units`` attribute must be a magnetic-field unit):
+        9D with a heading-only update, ENU world frame (x east, y magnetic north,
+        z up).
     gyr_noise : float
         Gyroscope angular random walk σ_ω (rad/√s), ``>= 0``.
     bias_noise : float
@@ -262,7 +268,8 @@ def eskf(
         Initial orientation; default :func:`initial_orientation` over
         ``init_window_s`` seconds (with ``mag``: TRIAD, ENU).
     b0 : array_like, shape (3,), optional
-        Initial gyro bias (rad/s), default zero.
+        Initial gyro bias (rad/s, whatever the units of a labelled ``gyr``), default
+        zero.
     init_window_s : float
         Initialisation window (s).
     return_bias : bool
@@ -330,8 +337,7 @@ def eskf(
        instrumented helmet using neural networks", Measurement and Control
        56(7-8):1156-1167, 2023. doi:10.1177/00202940221149062
     """
-    fs = _v.check_fs(fs)
-    acc, gyr, m, use_mag = sensor_inputs(acc, gyr, mag)
+    fs, acc, gyr, m, use_mag = read_sensors(fs, acc, gyr, mag, acc_si=True)
     gyr_noise = _v.nonnegative(gyr_noise, "gyr_noise")
     bias_noise = _v.nonnegative(bias_noise, "bias_noise")
     acc_noise = _v.positive(acc_noise, "acc_noise")

@@ -4,15 +4,14 @@ from __future__ import annotations
 
 import numpy as np
 
-from .. import _validate as _v
 from .. import dsp
-from ._common import samples, tilt_quaternion
+from ._common import samples, tilt_quaternion, unlabel
 
 __all__ = ["lowpass_tilt"]
 
 
 def lowpass_tilt(
-    acc, fs: float, *, cutoff_hz: float = 1.0, order: int = 2
+    acc, fs: float | None = None, *, cutoff_hz: float = 1.0, order: int = 2
 ) -> np.ndarray:
     r"""Tilt from the low-passed accelerometer (zero-phase Butterworth).
 
@@ -23,10 +22,13 @@ def lowpass_tilt(
 
     Parameters
     ----------
-    acc : array_like, shape (N, 3)
-        Specific force (any unit).
-    fs : float
-        Sampling rate (Hz), mandatory.
+    acc : array_like or xarray.DataArray, shape (N, 3)
+        Specific force (any unit). A labelled DataArray is read by its attributes
+        (``units``: converted to m/s² when present; ``fs``; see
+        :mod:`tiltlab.filters`, "Labelled inputs").
+    fs : float, optional
+        Sampling rate (Hz): mandatory for plain arrays; with labelled inputs it may
+        be omitted when they carry ``attrs["fs"]``, and must agree with it when given.
     cutoff_hz : float
         Cut-off frequency (Hz), ``0 < cutoff_hz < fs/2``.
     order : int
@@ -36,7 +38,7 @@ def lowpass_tilt(
     -------
     numpy.ndarray, shape (N, 4)
     """
-    fs = _v.check_fs(fs)
+    fs, acc, _, _ = unlabel(fs, acc=acc)
     acc = samples(acc, "acc")
     lp = dsp.lowpass(acc, fs, cutoff_hz, order=order, name="acc")
     n = np.linalg.norm(lp, axis=1, keepdims=True)

@@ -14,7 +14,7 @@ from numba import njit, prange
 
 from .. import _validate as _v
 from ..quaternion import qmul_scalar, rotate_scalar
-from ._common import sensor_inputs, start_orientation
+from ._common import read_sensors, start_orientation
 
 __all__ = ["madgwick", "madgwick_batch"]
 
@@ -106,7 +106,7 @@ def _madgwick_batch_kernel(acc, gyr, mag, use_mag, dt, betas, q0, out):
 def madgwick(
     acc,
     gyr,
-    fs: float,
+    fs: float | None = None,
     *,
     mag=None,
     beta: float = 0.05,
@@ -131,12 +131,17 @@ def madgwick(
 
     Parameters
     ----------
-    acc, gyr : array_like, shape (N, 3)
+    acc, gyr : array_like or xarray.DataArray, shape (N, 3)
         Specific force (any unit, normalised per sample) and angular velocity (rad/s).
-    fs : float
-        Sampling rate (Hz), mandatory.
-    mag : array_like, shape (N, 3), optional
-        Magnetometer (any unit): 9D, ENU world frame.
+        Labelled inputs (:class:`xarray.DataArray`) are read by their attributes:
+        ``gyr`` is converted from its ``units`` (required) to rad/s, ``acc`` with
+        ``units`` to m/s² (see :mod:`tiltlab.filters`, "Labelled inputs").
+    fs : float, optional
+        Sampling rate (Hz): mandatory for plain arrays; with labelled inputs it may
+        be omitted when they carry ``attrs["fs"]``, and must agree with it when given.
+    mag : array_like or xarray.DataArray, shape (N, 3), optional
+        Magnetometer (any unit; a ``units`` attribute must be a magnetic-field unit):
+        9D, ENU world frame.
     beta : float
         Gradient step (rad/s), ``>= 0``.
     q0 : array_like, shape (4,), optional
@@ -149,8 +154,7 @@ def madgwick(
     -------
     numpy.ndarray, shape (N, 4)
     """
-    fs = _v.check_fs(fs)
-    acc, gyr, m, use_mag = sensor_inputs(acc, gyr, mag)
+    fs, acc, gyr, m, use_mag = read_sensors(fs, acc, gyr, mag)
     beta = _v.nonnegative(beta, "beta")
     q0 = start_orientation(q0, acc, m if use_mag else None, fs, init_window_s)
     out = np.empty((acc.shape[0], 4))
@@ -161,7 +165,7 @@ def madgwick(
 def madgwick_batch(
     acc,
     gyr,
-    fs: float,
+    fs: float | None = None,
     *,
     betas,
     mag=None,
@@ -182,8 +186,7 @@ def madgwick_batch(
     numpy.ndarray, shape (P, N, 4)
         ``out[p]`` equals ``madgwick(acc, gyr, fs, beta=betas[p], ...)`` exactly.
     """
-    fs = _v.check_fs(fs)
-    acc, gyr, m, use_mag = sensor_inputs(acc, gyr, mag)
+    fs, acc, gyr, m, use_mag = read_sensors(fs, acc, gyr, mag)
     b = _v.vectors(np.atleast_1d(betas), "betas", width=None, ndim=1)
     for j, v in enumerate(b):
         _v.nonnegative(v, f"betas[{j}]")

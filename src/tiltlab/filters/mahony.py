@@ -11,7 +11,7 @@ from numba import njit
 
 from .. import _validate as _v
 from ..quaternion import qmul_scalar, rotate_scalar
-from ._common import sensor_inputs, start_orientation
+from ._common import read_sensors, start_orientation
 
 __all__ = ["mahony"]
 
@@ -73,7 +73,7 @@ def _mahony_kernel(acc, gyr, mag, use_mag, dt, kp, ki, q0, b0, out, bias):
 def mahony(
     acc,
     gyr,
-    fs: float,
+    fs: float | None = None,
     *,
     mag=None,
     kp: float = 1.0,
@@ -100,12 +100,17 @@ def mahony(
 
     Parameters
     ----------
-    acc, gyr : array_like, shape (N, 3)
+    acc, gyr : array_like or xarray.DataArray, shape (N, 3)
         Specific force (any unit) and angular velocity (rad/s).
-    fs : float
-        Sampling rate (Hz), mandatory.
-    mag : array_like, shape (N, 3), optional
-        Magnetometer (any unit): 9D, ENU world frame.
+        Labelled inputs (:class:`xarray.DataArray`) are read by their attributes:
+        ``gyr`` is converted from its ``units`` (required) to rad/s, ``acc`` with
+        ``units`` to m/s² (see :mod:`tiltlab.filters`, "Labelled inputs").
+    fs : float, optional
+        Sampling rate (Hz): mandatory for plain arrays; with labelled inputs it may
+        be omitted when they carry ``attrs["fs"]``, and must agree with it when given.
+    mag : array_like or xarray.DataArray, shape (N, 3), optional
+        Magnetometer (any unit; a ``units`` attribute must be a magnetic-field unit):
+        9D, ENU world frame.
     kp, ki : float
         Proportional (rad/s) and integral (rad/s²) gains, ``>= 0``, with
         ``kp/fs <= 2`` and ``ki/fs² <= 1`` (larger steps diverge). The default
@@ -117,14 +122,19 @@ def mahony(
         Initial orientation; default :func:`initial_orientation` over
         ``init_window_s`` seconds.
     b0 : array_like, shape (3,), optional
-        Initial gyro bias (rad/s), default zero.
+        Initial gyro bias (rad/s, whatever the units of a labelled ``gyr``), default
+        zero.
     init_window_s : float
         Initialisation window (s).
     return_bias : bool
-        Also return the bias estimates, shape (N, 3).
+        Also return the bias estimates, shape (N, 3) (rad/s).
+
+    Returns
+    -------
+    numpy.ndarray, shape (N, 4)
+        Unit quaternions sensor → world; with ``return_bias`` a tuple ``(q, b)``.
     """
-    fs = _v.check_fs(fs)
-    acc, gyr, m, use_mag = sensor_inputs(acc, gyr, mag)
+    fs, acc, gyr, m, use_mag = read_sensors(fs, acc, gyr, mag)
     kp = _v.nonnegative(kp, "kp")
     ki = _v.nonnegative(ki, "ki")
     # one step turns the estimate by at most kp/fs (+ the bias step ki/fs²) radians

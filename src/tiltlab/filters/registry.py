@@ -37,6 +37,7 @@ import numpy as np
 from .. import _validate as _v
 from .. import dsp
 from . import adapters
+from ._common import unlabel
 from .complementary import complementary
 from .ekf import ekf
 from .eskf import eskf
@@ -206,7 +207,12 @@ class Method:
 
 
 def vector_observation(
-    acc, fs: float, *, mag, dip: float | None = None, cutoff_hz: float | None = None
+    acc,
+    fs: float | None = None,
+    *,
+    mag,
+    dip: float | None = None,
+    cutoff_hz: float | None = None,
 ):
     r"""Orientation from the accelerometer and magnetometer alone, sample by sample
     (Davenport's q-method, :func:`tiltlab.filters.davenport`); no gyroscope.
@@ -220,12 +226,15 @@ def vector_observation(
 
     Parameters
     ----------
-    acc : array_like, shape (N, 3)
+    acc : array_like or xarray.DataArray, shape (N, 3)
         Specific force (any unit; only its direction is used).
-    fs : float
-        Sampling rate (Hz), mandatory.
-    mag : array_like, shape (N, 3)
-        Magnetic field (any unit; only its direction is used). Required.
+    fs : float, optional
+        Sampling rate (Hz): mandatory for plain arrays; with labelled inputs it may
+        be omitted when they carry ``attrs["fs"]``, and must agree with it when given.
+    mag : array_like or xarray.DataArray, shape (N, 3)
+        Magnetic field (any unit; only its direction is used). Required. Labelled
+        inputs are read as in the filters (:mod:`tiltlab.filters`, "Labelled
+        inputs").
     dip : float, optional
         Magnetic dip (rad, positive downwards); default: measured from the recording,
         the mean of :func:`tiltlab.filters.magnetic_dip` over its samples.
@@ -255,7 +264,7 @@ def vector_observation(
        Determination and Control*, Springer, 2014, §5.5.
        doi:10.1007/978-1-4939-0802-8
     """
-    fs = _v.check_fs(fs)
+    fs, acc, _, mag = unlabel(fs, acc=acc, mag=mag)
     a = _v.vectors(acc, "acc", width=3, ndim=2)
     m = _v.vectors(mag, "mag", width=3, ndim=2)
     if a.shape != m.shape:

@@ -16,7 +16,7 @@ from ..quaternion import (
     rotvec_to_quat_scalar,
     zoh_step_scalar,
 )
-from ._common import samples, start_orientation
+from ._common import samples, start_orientation, unlabel
 from .smoothers import rest_gyro_bias
 
 __all__ = ["rts_smoother"]
@@ -639,7 +639,7 @@ def _rts_plan(
 def rts_smoother(
     acc,
     gyr,
-    fs: float,
+    fs: float | None = None,
     *,
     gyr_noise: float = 5e-3,
     bias_noise: float = 1e-4,
@@ -722,12 +722,15 @@ def rts_smoother(
 
     Parameters
     ----------
-    acc : array_like, shape (N, 3)
-        Specific force in **m/s²**.
-    gyr : array_like, shape (N, 3)
-        Angular velocity (rad/s).
-    fs : float
-        Sampling rate (Hz), mandatory.
+    acc : array_like or xarray.DataArray, shape (N, 3)
+        Specific force in **m/s²**; a labelled DataArray is converted from its
+        ``units`` attribute (required).
+    gyr : array_like or xarray.DataArray, shape (N, 3)
+        Angular velocity (rad/s); a labelled DataArray is converted from its ``units``
+        attribute (required; see :mod:`tiltlab.filters`, "Labelled inputs").
+    fs : float, optional
+        Sampling rate (Hz): mandatory for plain arrays; with labelled inputs it may
+        be omitted when they carry ``attrs["fs"]``, and must agree with it when given.
     gyr_noise : float
         Angular random walk σ_ω (rad/√s), gyro noise plus unmodelled scale errors.
     bias_noise : float
@@ -751,7 +754,8 @@ def rts_smoother(
         Initial standard deviation (1) and random walk (1/√s) of the gyro scale errors;
         the default 0 switches scale estimation off.
     bias : array_like, shape (3,), optional
-        Initial gyro bias (rad/s); default :func:`rest_gyro_bias`.
+        Initial gyro bias (rad/s, whatever the units of a labelled ``gyr``); default
+        :func:`rest_gyro_bias`.
     q0 : array_like, shape (4,), optional
         Initial orientation; default :func:`initial_orientation` over
         ``init_window_s`` seconds.
@@ -806,7 +810,7 @@ def rts_smoother(
        estimation and magnetic disturbance rejection", Information Fusion 91:187–204,
        2023. doi:10.1016/j.inffus.2022.10.014
     """
-    fs = _v.check_fs(fs)
+    fs, acc, gyr, _ = unlabel(fs, acc=acc, gyr=gyr, acc_si=True)
     acc = samples(acc, "acc")
     gyr = samples(gyr, "gyr", acc.shape[0])
     max_memory_gb = _v.positive(max_memory_gb, "max_memory_gb", allow_inf=True)

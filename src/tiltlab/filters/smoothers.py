@@ -7,7 +7,7 @@ import numpy as np
 from .. import _validate as _v
 from .. import dsp
 from .. import quaternion as quat
-from ._common import samples, start_orientation, tilt_quaternion
+from ._common import samples, start_orientation, tilt_quaternion, unlabel
 
 __all__ = ["rest_gyro_bias", "smoother"]
 
@@ -15,7 +15,7 @@ __all__ = ["rest_gyro_bias", "smoother"]
 def rest_gyro_bias(
     acc,
     gyr,
-    fs: float,
+    fs: float | None = None,
     *,
     window_s: float = 0.5,
     threshold_rad_s: float = np.radians(2.0),
@@ -33,27 +33,33 @@ def rest_gyro_bias(
 
     Parameters
     ----------
-    acc : array_like, shape (N, 3)
-        Specific force (``acc_std_threshold`` is in its unit).
-    gyr : array_like, shape (N, 3)
-        Angular velocity (rad/s).
-    fs : float
-        Sampling rate (Hz), mandatory.
+    acc : array_like or xarray.DataArray, shape (N, 3)
+        Specific force (``acc_std_threshold`` is in its unit: m/s² for a labelled
+        DataArray, which is converted from its ``units`` attribute, required).
+    gyr : array_like or xarray.DataArray, shape (N, 3)
+        Angular velocity (rad/s; a labelled DataArray is converted to rad/s from its
+        ``units`` attribute, which it must have; see :mod:`tiltlab.filters`,
+        "Labelled inputs").
+    fs : float, optional
+        Sampling rate (Hz): mandatory for plain arrays; with labelled inputs it may
+        be omitted when they carry ``attrs["fs"]``, and must agree with it when given.
     window_s : float
         Smoothing window (s).
     threshold_rad_s : float
         Largest mean angular speed (rad/s) at rest.
     acc_std_threshold : float
-        Largest moving standard deviation of :math:`\|a\|` at rest.
+        Largest moving standard deviation of :math:`\|a\|` at rest (units of ``acc``;
+        m/s² for a labelled ``acc``; the default suits m/s²).
     min_rest_s : float
         Shortest rest period kept (s).
 
     Returns
     -------
     bias : numpy.ndarray, shape (3,)
+        In rad/s (also for a labelled ``gyr``).
     rest : numpy.ndarray of bool, shape (N,)
     """
-    fs = _v.check_fs(fs)
+    fs, acc, gyr, _ = unlabel(fs, acc=acc, gyr=gyr, acc_si=True)
     acc = samples(acc, "acc")
     gyr = samples(gyr, "gyr", acc.shape[0])
     window_s = _v.positive(window_s, "window_s")
@@ -73,7 +79,7 @@ def rest_gyro_bias(
 def smoother(
     acc,
     gyr,
-    fs: float,
+    fs: float | None = None,
     *,
     cutoff_hz: float = 0.1,
     order: int = 2,
@@ -102,19 +108,22 @@ def smoother(
 
     Parameters
     ----------
-    acc : array_like, shape (N, 3)
-        Specific force in m/s² (the rest detector's threshold is in m/s²).
-    gyr : array_like, shape (N, 3)
-        Angular velocity (rad/s).
-    fs : float
-        Sampling rate (Hz), mandatory.
+    acc : array_like or xarray.DataArray, shape (N, 3)
+        Specific force in m/s² (the rest detector's threshold is in m/s²); a labelled
+        DataArray is converted from its ``units`` attribute (required).
+    gyr : array_like or xarray.DataArray, shape (N, 3)
+        Angular velocity (rad/s); a labelled DataArray is converted from its ``units``
+        attribute (required; see :mod:`tiltlab.filters`, "Labelled inputs").
+    fs : float, optional
+        Sampling rate (Hz): mandatory for plain arrays; with labelled inputs it may
+        be omitted when they carry ``attrs["fs"]``, and must agree with it when given.
     cutoff_hz : float
         Cut-off (Hz) of the low-pass: below the motion frequencies, above the drift of
         :math:`D` (bias residual, gyro scale errors).
     order : int
         Butterworth order of each pass.
     bias : array_like, shape (3,), optional
-        Known gyro bias (rad/s).
+        Known gyro bias (rad/s, whatever the units of a labelled ``gyr``).
     q0 : array_like, shape (4,), optional
         Start of the integration (fixes the heading origin); default identity.
 
@@ -122,7 +131,7 @@ def smoother(
     -------
     numpy.ndarray, shape (N, 4)
     """
-    fs = _v.check_fs(fs)
+    fs, acc, gyr, _ = unlabel(fs, acc=acc, gyr=gyr, acc_si=True)
     acc = samples(acc, "acc")
     gyr = samples(gyr, "gyr", acc.shape[0])
     if bias is None:

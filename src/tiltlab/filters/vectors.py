@@ -35,6 +35,7 @@ from __future__ import annotations
 import numpy as np
 
 from .. import _validate as _v
+from ._common import unlabel
 
 __all__ = ["davenport", "magnetic_dip"]
 
@@ -58,13 +59,17 @@ def magnetic_dip(acc, mag) -> float:
 
     Parameters
     ----------
-    acc, mag : array_like, shape (N, 3) or (3,)
-        Accelerometer and magnetometer samples (any units), quasi-static.
+    acc, mag : array_like or xarray.DataArray, shape (N, 3) or (3,)
+        Accelerometer and magnetometer samples (any units), quasi-static. Labelled
+        DataArrays must agree on ``fs`` and ``time``; a ``units`` attribute must be
+        an acceleration (``acc``) or magnetic-field (``mag``) unit (see
+        :mod:`tiltlab.filters`, "Labelled inputs").
 
     Returns
     -------
     float
     """
+    _, acc, _, mag = unlabel(None, acc=acc, mag=mag, need_fs=False)
     a = _unit_rows(acc, "acc")
     m = _unit_rows(mag, "mag")
     if a.shape != m.shape:
@@ -80,10 +85,13 @@ def davenport(acc, mag, *, dip: float, weights: tuple[float, float] = (1.0, 1.0)
 
     Parameters
     ----------
-    acc : array_like, shape (N, 3) or (3,)
+    acc : array_like or xarray.DataArray, shape (N, 3) or (3,)
         Specific force (any unit; only its direction is used): gravity up when static.
-    mag : array_like, shape (N, 3) or (3,)
-        Magnetic field (any unit; only its direction is used).
+    mag : array_like or xarray.DataArray, shape (N, 3) or (3,)
+        Magnetic field (any unit; only its direction is used). Labelled DataArrays
+        must agree on ``fs`` and ``time``; a ``units`` attribute must be an
+        acceleration (``acc``) or magnetic-field (``mag``) unit (see
+        :mod:`tiltlab.filters`, "Labelled inputs").
     dip : float
         Magnetic dip (rad, positive downwards), e.g. :func:`magnetic_dip` of a still
         period.
@@ -103,6 +111,7 @@ def davenport(acc, mag, *, dip: float, weights: tuple[float, float] = (1.0, 1.0)
     is shared; with a dominant accelerometer weight it tends to TRIAD with gravity as
     the primary vector.
     """
+    _, acc, _, mag = unlabel(None, acc=acc, mag=mag, need_fs=False)
     a = _unit_rows(acc, "acc")
     m = _unit_rows(mag, "mag")
     if a.shape != m.shape:
