@@ -60,14 +60,27 @@ def registry() -> dict[str, dict[str, str]]:
     base = resources.files("tiltlab") / "_registry"
     meta = json.loads((base / "datasets.json").read_text())
     out: dict[str, dict[str, str]] = {}
-    for line in (base / "registry.txt").read_text().splitlines():
+    lines = (base / "registry.txt").read_text().splitlines()
+    for number, line in enumerate(lines, start=1):
         if not line.strip() or line.startswith("#"):
             continue
-        name, digest, url = line.split()
+        where = f"tiltlab registry (_registry/registry.txt), line {number}"
+        fields = line.split()
+        if len(fields) != 3:
+            raise DataError(
+                f"{where}: malformed entry {line!r}; expected 'NAME sha256:HEX URL'"
+            )
+        name, digest, url = fields
         algo, _, h = digest.partition(":")
         if algo != "sha256":
-            raise DataError(f"registry entry {name}: unsupported hash {algo!r}")
+            raise DataError(f"{where}: entry {name}: unsupported hash {algo!r}")
+        if not re.fullmatch(r"[0-9a-f]{64}", h):
+            raise DataError(f"{where}: entry {name}: {h!r} is not a SHA-256 (64 hex)")
+        if name in out:
+            raise DataError(f"{where}: {name} is listed twice")
         out[name] = {"sha256": h, "url": url, **meta["files"].get(name, {})}
+    if not out:
+        raise DataError("tiltlab registry (_registry/registry.txt) has no entries")
     return out
 
 

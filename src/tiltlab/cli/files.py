@@ -76,6 +76,29 @@ def _looks_like(source: str) -> str | None:
         return None
 
 
+_NO_CHECKSUM = (
+    "{source}: no checksum stored (written before tiltlab stored checksums, or by "
+    "another tool): its values cannot be checked for corruption; 'tiltlab convert "
+    "{source} --out NEW.nc' writes a copy with checksums"
+)
+
+
+def _checksums(source: str, what: str | None) -> str | None:
+    """For a tiltlab NetCDF Recording, what its checksums say: ``"verified (…)"`` or
+    ``"none stored"``; None for any other source.
+
+    Called once the file has loaded, which verified the checksums it holds (a
+    mismatch has been raised as an :class:`~tiltlab.io.IntegrityError`)."""
+    from .. import io
+
+    if what is None or not what.startswith("tiltlab Recording"):
+        return None
+    sums = io.netcdf_checksums(source)
+    if sums is None:
+        return "none stored"
+    return f"verified (sha256 of {len(sums['variables'])} variables and the attributes)"
+
+
 def _cmd_info(args: argparse.Namespace) -> int:
     from .. import schema
 
@@ -84,6 +107,9 @@ def _cmd_info(args: argparse.Namespace) -> int:
         rec = _load(args.source, args.mapping, cmd="info", check_units=args.check_units)
     if what is not None:
         print(f"{'file':>14}: {what}")
+    sums = _checksums(args.source, what)
+    if sums is not None:
+        print(f"{'checksums':>14}: {sums}")
     for k, v in schema.describe(rec).items():
         print(f"{k:>14}: {float(f'{v:.7g}') if isinstance(v, float) else v}")
     if "fs_source" in rec.attrs:
@@ -107,11 +133,16 @@ def _cmd_validate(args: argparse.Namespace) -> int:
         # a file read by conversion is not a Recording file: say what it is
         raise io.NotRecordingError(args.source, what)
     # quality warnings are part of the report (stdout), one line each; they do not
-    # change the exit status, errors do (one line on stderr, from main)
+    # change the exit status, errors do (one line on stderr, from main). A saved
+    # Recording's checksums are verified as it loads: a mismatch is an error naming
+    # the variable; a file without checksums (written before tiltlab stored them)
+    # is valid, with a warning saying so.
     with _quality_lines(lambda t: print(f"warning: {t}")) as lines:
         rec = _load(
             args.source, args.mapping, cmd="validate", check_units=args.check_units
         )
+        if _checksums(args.source, what) == "none stored":
+            warnings.warn(_NO_CHECKSUM.format(source=args.source), stacklevel=1)
         try:
             schema.validate(rec, allow_nan=True, check_units=args.check_units)
         except UnitCheckError as err:

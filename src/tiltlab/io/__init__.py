@@ -19,13 +19,15 @@ Supported formats
 * One numeric variable of a MATLAB file, v4–v7 or v7.3/HDF5 (``read_matrix``), in
   MATLAB's own shape.
 * NetCDF via h5netcdf (``save_netcdf`` / ``load_netcdf``), exact round trip
-  including attributes of any JSON-serialisable type; ``open_netcdf`` opens any
-  NetCDF-4 or NetCDF-3 file as stored.
+  including attributes of any JSON-serialisable type, each variable's SHA-256 stored
+  and verified on load (:class:`IntegrityError` on a mismatch, ``verify=False`` to
+  salvage; ``netcdf_checksums`` reads them); ``open_netcdf`` opens any NetCDF-4 or
+  NetCDF-3 file as stored.
 """
 
 from __future__ import annotations
 
-from ._common import ReadError
+from ._common import IntegrityError, ReadError
 from .broad import read_broad
 from .csv import FS_RANGE, GAP_POLICIES, TIME_UNITS, read_csv, read_csv_mapping
 from .detect import detect, read
@@ -36,6 +38,7 @@ from .multi import read_multi
 from .netcdf import (
     NotRecordingError,
     load_netcdf,
+    netcdf_checksums,
     netcdf_format,
     open_netcdf,
     save_netcdf,
@@ -44,6 +47,7 @@ from .tagtools import read_tagtools, write_tagtools
 
 __all__ = [
     "ReadError",
+    "IntegrityError",
     "NotRecordingError",
     "read",
     "detect",
@@ -64,4 +68,5 @@ __all__ = [
     "load_netcdf",
     "open_netcdf",
     "netcdf_format",
+    "netcdf_checksums",
 ]

@@ -16,6 +16,30 @@ class ReadError(OSError):
     """A file is missing, truncated, corrupt or not in the expected layout."""
 
 
+class IntegrityError(ReadError, ValueError):
+    """A file's content differs from the checksum recorded when it was written.
+
+    Raised by :func:`tiltlab.io.load_netcdf` (a variable or the attributes of a
+    saved Recording changed since :func:`tiltlab.io.save_netcdf` wrote them) and by
+    :mod:`tiltlab.learn` (model weights that differ from their recorded sha256, or
+    a malformed ``SHA256SUMS`` file). The message names the file and, where there is
+    one, the variable (also in :attr:`path` and :attr:`variable`). A
+    :class:`ReadError` (an :class:`OSError`) and a :class:`ValueError`.
+    """
+
+    def __init__(self, message: str, *, path=None, variable: str | None = None):
+        super().__init__(message)
+        self.path = None if path is None else Path(path)
+        self.variable = variable
+
+    def __reduce__(self):
+        return (_integrity_error, (str(self), self.path, self.variable))
+
+
+def _integrity_error(message, path, variable):
+    return IntegrityError(message, path=path, variable=variable)
+
+
 def _missing_columns_message(
     path: Path,
     df: pd.DataFrame,

@@ -27,7 +27,16 @@ from .data import Sequence, sequence, window_ends
 from .losses import LOSSES, TOTALS, qae, sample_loss, total_loss
 from .model import ACTIVATIONS, OrientationCNN
 from .optim import Lookahead, radam_lookahead
-from .training import TrainConfig, build_model, load, run, save, sha256, train
+from .training import (
+    TrainConfig,
+    build_model,
+    load,
+    read_sums,
+    run,
+    save,
+    sha256,
+    train,
+)
 from .published import ZAHEER_TABLE2, ZAHEER_TABLE3
 from .cv import BASELINES, check_files, compare, cross_validate, folds, learned_estimate
 
@@ -51,6 +60,7 @@ __all__ = [
     "save",
     "load",
     "sha256",
+    "read_sums",
     "BASELINES",
     "check_files",
     "compare",

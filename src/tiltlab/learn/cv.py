@@ -11,7 +11,8 @@ Files written by :func:`cross_validate` (the ``learn`` command) in its output fo
 * ``run.json``: the command line, the configurations, the folds, package versions;
 * ``history.json``: training curves (per variant, fold and epoch);
 * ``metrics.json``: per test trial, QAE (Eq. 4, degrees) and BROAD's RMSEs;
-* ``SHA256SUMS``: the sha256 of every file above, checked by :func:`check_files`.
+* ``SHA256SUMS``: the sha256 of every file above, checked by :func:`check_files`,
+  and by :func:`load` for each weights file it loads.
 """
 
 from __future__ import annotations
@@ -32,7 +33,18 @@ from .. import evaluate
 from .. import filters
 from .. import quaternion as quat
 from .data import sequence
-from .training import TrainConfig, load, run, save, sha256, train, write_json
+from ..io import IntegrityError
+from .training import (
+    SUMS_FILE,
+    TrainConfig,
+    load,
+    read_sums,
+    run,
+    save,
+    sha256,
+    train,
+    write_json,
+)
 
 __all__ = [
     "ABLATIONS",
@@ -258,31 +270,41 @@ def _write_sums(out: Path) -> None:
         p.name for p in out.iterdir() if p.suffix in (".pt", ".json") and p.is_file()
     )
     lines = [f"{sha256(out / n)}  {n}" for n in names]
-    (out / "SHA256SUMS").write_text("\n".join(lines) + "\n")
+    (out / SUMS_FILE).write_text("\n".join(lines) + "\n")
 
 
 def check_files(folder: str | Path) -> dict[str, str]:
     """Verify every file listed in ``folder/SHA256SUMS``; return name -> sha256.
 
+    ``SHA256SUMS`` is parsed strictly (:func:`~tiltlab.learn.training.read_sums`):
+    blank lines are ignored and the ``*`` binary marker accepted; an empty file or a
+    malformed line is an error naming the line.
+
     Raises
     ------
+    tiltlab.io.IntegrityError
+        (a ``ValueError``) naming the first file that is missing or whose checksum
+        differs, or the line of ``SHA256SUMS`` that is malformed.
     ValueError
-        Naming the first file that is missing or whose checksum differs.
+        If there is no ``SHA256SUMS``.
     """
     folder = Path(folder)
-    sums = folder / "SHA256SUMS"
+    sums = folder / SUMS_FILE
     if not sums.is_file():
-        raise ValueError(f"no SHA256SUMS in {folder}")
+        raise ValueError(f"no {SUMS_FILE} in {folder}")
     out = {}
-    for line in sums.read_text().splitlines():
-        digest, name = line.split(None, 1)
-        path = folder / name.strip()
+    for name, digest in read_sums(sums).items():
+        path = folder / name
         if not path.is_file():
-            raise ValueError(f"{name} is listed in SHA256SUMS but missing")
+            raise IntegrityError(f"{name} is listed in {sums} but missing", path=path)
         got = sha256(path)
         if got != digest:
-            raise ValueError(f"{name}: sha256 {got} differs from SHA256SUMS {digest}")
-        out[name.strip()] = got
+            raise IntegrityError(
+                f"{name}: sha256 {got} differs from {sums} ({digest}): the file is "
+                "corrupt or was altered",
+                path=path,
+            )
+        out[name] = got
     return out
 
 
