@@ -52,6 +52,7 @@ __all__ = [
     "output",
     "start_time",
     "windowed",
+    "time_unit_hint",
 ]
 
 
@@ -175,9 +176,21 @@ def vectors(
         Accept NaN (never ±inf).
     min_length : int
         Minimum size of the first dimension.
+
+    Raises
+    ------
+    ValueError
+        Non-numeric or complex data (complex values are refused even when their
+        imaginary part is zero: converting them would silently drop it), a wrong shape,
+        too few samples, or non-finite values.
     """
     try:
-        x = np.array(a, dtype=float)
+        raw = np.asarray(a)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be numeric, got {type(a).__name__}") from None
+    _not_complex(raw, name)
+    try:
+        x = np.array(raw, dtype=float)
     except (TypeError, ValueError):
         raise ValueError(f"{name} must be numeric, got {type(a).__name__}") from None
     if ndim is not None and x.ndim != ndim:
@@ -196,6 +209,62 @@ def vectors(
         what = "non-finite" if not allow_nan else "infinite"
         raise ValueError(f"{name} has {int(bad.sum())} {what} values")
     return x
+
+
+def _not_complex(raw: np.ndarray, name: str) -> None:
+    """Refuse complex data by name (a float conversion would drop the imaginary part)."""
+    if raw.dtype.kind == "c":
+        nonzero = int(np.count_nonzero(np.imag(raw)))
+        part = (
+            f"{nonzero} of them with a non-zero imaginary part"
+            if nonzero
+            else "all imaginary parts are zero"
+        )
+        raise ValueError(
+            f"{name} holds complex numbers (dtype {raw.dtype}, {part}); tiltlab takes "
+            f"real values and never drops an imaginary part silently: pass "
+            f"{name}.real explicitly if that is what you mean"
+        )
+
+
+_TIME_UNIT_STEPS = (("milliseconds", 1e3), ("microseconds", 1e6), ("nanoseconds", 1e9))
+
+
+def time_unit_hint(step: float, fs: float) -> str:
+    """A hint naming the time unit that makes a median step ``step`` agree with ``fs``.
+
+    When ``step * fs`` is close (within 1 %) to 10³, 10⁶ or 10⁹, the time axis is most
+    likely in milliseconds, microseconds or nanoseconds instead of seconds; the hint
+    says so (``""`` otherwise).
+    """
+    if not (np.isfinite(step) and step > 0):
+        return ""
+    ratio = step * fs
+    for unit, factor in _TIME_UNIT_STEPS:
+        if abs(ratio / factor - 1.0) <= 0.01:
+            return (
+                f"; the time axis looks like {unit}, not seconds: divide it by "
+                f"{factor:g} (a Recording's time is in seconds)"
+            )
+    return ""
+
+
+def _numeric_time(coord, where: str) -> np.ndarray:
+    """A time coordinate as float seconds; date-times and durations are refused by name."""
+    values = np.asarray(coord.values)
+    if values.dtype.kind in "mM":
+        kind = "date-times" if values.dtype.kind == "M" else "durations"
+        raise RecordingError(
+            f"{where}: the time coordinate holds {kind} ({values.dtype}), not seconds; "
+            "a Recording's time is a float number of seconds: convert it, e.g. "
+            "ds.assign_coords(time=(ds.time - ds.time[0]) / np.timedelta64(1, 's'))"
+            + (
+                " and keep the absolute start in attrs['time_origin']"
+                if values.dtype.kind == "M"
+                else ""
+            )
+        )
+    return np.asarray(values, dtype=float)
 
 
 @dataclass(frozen=True)
@@ -226,6 +295,7 @@ def _time_fs_check(time: np.ndarray, fs: float, where: str) -> None:
         raise RecordingError(
             f"{where}: attribute fs = {fs:g} Hz contradicts the time coordinate "
             f"(median step {med:.6g} s, i.e. {1.0 / med:.6g} Hz)"
+            + time_unit_hint(med, fs)
         )
 
 
@@ -271,6 +341,16 @@ def signal(
     Returns
     -------
     Signal
+
+    Raises
+    ------
+    RecordingError
+        A missing or contradictory ``fs`` or unit, a missing variable, or a ``time``
+        coordinate that is not float seconds (date-times or durations are refused with
+        the conversion to write; a step that is 10³, 10⁶ or 10⁹ times ``1/fs`` names
+        the likely time unit).
+    ValueError
+        Complex, non-numeric, mis-shaped or non-finite values (see :func:`vectors`).
     """
     attrs: dict[str, Any] = {}
     time = None
@@ -299,9 +379,11 @@ def signal(
         own_fs = None
         own_units = None
     if labelled:
-        values = np.array(da.values, dtype=float)
+        raw = np.asarray(da.values)
+        _not_complex(raw, name)
+        values = np.array(raw, dtype=float)
         if "time" in da.coords and da.coords["time"].ndim == 1:
-            time = np.asarray(da.coords["time"].values, dtype=float)
+            time = _numeric_time(da.coords["time"], where)
         values = vectors(values, name, width=width, ndim=ndim, allow_nan=allow_nan)
     else:
         values = vectors(data, name, width=width, ndim=ndim, allow_nan=allow_nan)

@@ -16,7 +16,8 @@ its arguments, never modifies its inputs and returns new arrays. The loops run i
 ``@njit(cache=True)`` kernels.
 
 Inputs are checked before the kernels run (:class:`ValueError` naming the argument):
-NaN marks a missing sample and propagates, but an infinite value, a zero quaternion or
+NaN marks a missing sample and propagates, but a complex value (never cut to its real
+part), an infinite value, a zero quaternion or
 vector (no rotation, no direction), a non-unit quaternion where a rotation matrix or
 angle is derived from it (:func:`to_matrix`, :func:`to_rotvec`, tolerance 1e-6) and a
 matrix that is not a rotation (:func:`from_matrix`: orthonormal within 1e-6, det +1)
@@ -63,6 +64,7 @@ __all__ = [
     "heading_error",
     "total_error",
     "integrate_gyro",
+    "slerp",
     "from_scipy",
     "to_scipy",
     "random_quaternions",
@@ -291,6 +293,18 @@ def _integrate_kernel(omega, dt, q0, out):
 # ---------------------------------------------------------------- wrappers
 
 
+def _real(a, name: str) -> np.ndarray:
+    """``a`` as a float array; complex input is refused by name (never cut to its
+    real part)."""
+    raw = np.asarray(a)
+    if raw.dtype.kind == "c":
+        raise ValueError(
+            f"{name} holds complex numbers (dtype {raw.dtype}); quaternions and vectors "
+            f"are real: pass {name}.real explicitly if that is what you mean"
+        )
+    return np.asarray(raw, float)
+
+
 def _as2d(a: np.ndarray, width: int) -> np.ndarray:
     return np.ascontiguousarray(a.reshape(-1, width), dtype=np.float64)
 
@@ -382,7 +396,7 @@ def mul(p, q) -> np.ndarray:
 
     With sensor → world quaternions, ``mul(p, q)`` applies ``q`` first, then ``p``.
     """
-    p, q = np.asarray(p, float), np.asarray(q, float)
+    p, q = _real(p, "p"), _real(q, "q")
     _check_last(p, 4, "p")
     _check_last(q, 4, "q")
     p, q = _broadcast(("p", _no_inf(p, "p")), ("q", _no_inf(q, "q")))
@@ -394,7 +408,7 @@ def mul(p, q) -> np.ndarray:
 
 def conj(q) -> np.ndarray:
     """Conjugate (w, −x, −y, −z): the inverse of a unit quaternion."""
-    q = np.array(q, dtype=float)
+    q = np.array(_real(q, "q"), dtype=float)
     _check_last(q, 4, "q")
     q[..., 1:] *= -1.0
     return q
@@ -402,7 +416,7 @@ def conj(q) -> np.ndarray:
 
 def inv(q) -> np.ndarray:
     """Inverse :math:`q^* / \\|q\\|^2` (equals :func:`conj` for unit quaternions)."""
-    q = np.asarray(q, float)
+    q = _real(q, "q")
     _check_last(q, 4, "q")
     _no_zero(_no_inf(q, "q"), "q")
     return conj(q) / np.sum(q * q, axis=-1, keepdims=True)
@@ -410,12 +424,12 @@ def inv(q) -> np.ndarray:
 
 def norm(q) -> np.ndarray:
     """Euclidean norm over the last axis."""
-    return np.linalg.norm(np.asarray(q, float), axis=-1)
+    return np.linalg.norm(_real(q, "q"), axis=-1)
 
 
 def normalize(q) -> np.ndarray:
     """Unit quaternions; a zero quaternion is an error."""
-    q = _no_inf(np.asarray(q, float), "q")
+    q = _no_inf(_real(q, "q"), "q")
     _check_last(q, 4, "q")
     n = np.linalg.norm(q, axis=-1, keepdims=True)
     if np.any(n == 0):
@@ -427,7 +441,7 @@ def normalize(q) -> np.ndarray:
 
 def canonical(q) -> np.ndarray:
     """The representative with w ≥ 0 (q and −q are the same rotation)."""
-    q = np.asarray(q, float)
+    q = _real(q, "q")
     return np.where(q[..., :1] < 0, -q, q)
 
 
@@ -442,7 +456,7 @@ def rotate_inverse(q, v) -> np.ndarray:
 
 
 def _rotate(q, v, inverse: bool) -> np.ndarray:
-    q, v = np.asarray(q, float), np.asarray(v, float)
+    q, v = _real(q, "q"), _real(v, "v")
     _check_last(q, 4, "q")
     _check_last(v, 3, "v")
     _no_zero(_no_inf(q, "q"), "q")
@@ -457,7 +471,7 @@ def _rotate(q, v, inverse: bool) -> np.ndarray:
 
 def to_matrix(q) -> np.ndarray:
     """Rotation matrices R(q), shape (..., 3, 3), mapping sensor to world coordinates."""
-    q = np.asarray(q, float)
+    q = _real(q, "q")
     _check_last(q, 4, "q")
     check_unit(q, "q")
     out = np.empty((int(np.prod(q.shape[:-1], dtype=np.int64)), 3, 3))
@@ -467,7 +481,7 @@ def to_matrix(q) -> np.ndarray:
 
 def from_matrix(m) -> np.ndarray:
     """Unit quaternions (w ≥ 0) from rotation matrices (Shepperd's method [2]_)."""
-    m = np.asarray(m, float)
+    m = _real(m, "m")
     if m.shape[-2:] != (3, 3):
         raise ValueError(f"m must have shape (..., 3, 3), got {m.shape}")
     check_rotation(m, "m")
@@ -478,7 +492,7 @@ def from_matrix(m) -> np.ndarray:
 
 def to_rotvec(q) -> np.ndarray:
     """Rotation vectors (axis × angle, angle in [0, π]) of unit quaternions."""
-    q = np.asarray(q, float)
+    q = _real(q, "q")
     _check_last(q, 4, "q")
     check_unit(q, "q")
     out = np.empty((int(np.prod(q.shape[:-1], dtype=np.int64)), 3))
@@ -488,7 +502,7 @@ def to_rotvec(q) -> np.ndarray:
 
 def from_rotvec(r) -> np.ndarray:
     r"""Unit quaternions :math:`(\cos\tfrac{\theta}{2}, \sin\tfrac{\theta}{2}\,\hat r)` from rotation vectors."""
-    r = _no_inf(np.asarray(r, float), "r")
+    r = _no_inf(_real(r, "r"), "r")
     _check_last(r, 3, "r")
     with np.errstate(over="ignore"):
         big = np.isinf(np.linalg.norm(r, axis=-1))
@@ -506,7 +520,7 @@ def exp(v) -> np.ndarray:
 
     Note ``exp(r / 2) == from_rotvec(r)``.
     """
-    return from_rotvec(2.0 * np.asarray(v, float))
+    return from_rotvec(2.0 * _real(v, "v"))
 
 
 def log(q) -> np.ndarray:
@@ -520,7 +534,7 @@ def gravity(q) -> np.ndarray:
     For a sensor at rest, this is the direction of the accelerometer reading
     (the specific force points up).
     """
-    q = np.asarray(q, float)
+    q = _real(q, "q")
     _check_last(q, 4, "q")
     _no_zero(_no_inf(q, "q"), "q")
     out = np.empty((int(np.prod(q.shape[:-1], dtype=np.int64)), 3))
@@ -530,7 +544,7 @@ def gravity(q) -> np.ndarray:
 
 def angle_between(u, v) -> np.ndarray:
     """Angle (rad) between vectors, computed as atan2(‖u×v‖, u·v) (accurate near 0 and π)."""
-    u, v = np.asarray(u, float), np.asarray(v, float)
+    u, v = _real(u, "u"), _real(v, "v")
     _check_last(u, 3, "u")
     _check_last(v, 3, "v")
     for name, a in (("u", u), ("v", v)):
@@ -557,7 +571,7 @@ def error_angles(q_est, q_ref) -> np.ndarray:
 
     See :func:`total_error`, :func:`heading_error` and :func:`tilt_error`.
     """
-    p, q = np.asarray(q_est, float), np.asarray(q_ref, float)
+    p, q = _real(q_est, "q_est"), _real(q_ref, "q_ref")
     _check_last(p, 4, "q_est")
     _check_last(q, 4, "q_ref")
     _no_zero(_no_inf(p, "q_est"), "q_est")
@@ -629,6 +643,80 @@ def integrate_gyro(omega, fs: float, q0=None) -> np.ndarray:
     if omega.shape[0]:
         _integrate_kernel(omega, 1.0 / fs, q0, out)
     return out
+
+
+def slerp(q0, q1, t) -> np.ndarray:
+    r"""Spherical linear interpolation of rotations along the shortest path.
+
+    .. math::
+        q(t) = \frac{\sin((1-t)\,\Omega)}{\sin\Omega}\,q_0
+             + \frac{\sin(t\,\Omega)}{\sin\Omega}\,s\,q_1,\qquad
+        s = \begin{cases}-1 & q_0\cdot q_1 < 0\\ +1 & \text{otherwise}\end{cases},
+
+    with :math:`\Omega = 2\,\mathrm{atan2}(\lVert q_0 - s q_1\rVert,
+    \lVert q_0 + s q_1\rVert)` the angle between :math:`q_0` and :math:`s q_1` on the
+    unit 3-sphere (half the rotation angle between the two orientations), accurate
+    near 0. The result turns at constant rate about one axis from :math:`q_0`
+    (``t = 0``) to the rotation of :math:`q_1` (``t = 1``; the returned quaternion is
+    then :math:`s q_1`, the same rotation).
+
+    Parameters
+    ----------
+    q0, q1 : array_like, shape (..., 4)
+        Unit quaternions (w, x, y, z) (norm 1 within 1e-6); NaN (a missing sample)
+        propagates.
+    t : array_like, shape (...)
+        Fractions along the path (finite; values outside [0, 1] extrapolate along the
+        same great circle). ``q0``, ``q1`` and ``t`` broadcast.
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., 4)
+        Unit quaternions.
+
+    Notes
+    -----
+    * ``q`` and ``−q`` are the same rotation: the sign of ``q1`` is chosen so that the
+      path is the shorter one (rotation angle at most 180°). ``slerp(q, -q, t)`` is
+      ``q`` for every ``t`` (no motion), never NaN.
+    * Two orientations exactly 180° apart (:math:`q_0\cdot q_1 = 0`) are joined by two
+      paths of equal length, the half-turns in either sense about the same axis (the
+      axis of :math:`q_0^{-1} q_1`). The documented choice is :math:`s = +1`: ``q1``
+      is used as given, i.e. the positive half-turn about that axis; pass ``-q1`` for
+      the other sense. Just off 180° the shorter path is taken, so the result jumps
+      between the two senses as :math:`q_0\cdot q_1` changes sign — unavoidable for any
+      shortest-path rule.
+    * Below :math:`\Omega = 10^{-6}` the normalised linear interpolation is used (the
+      same path to rounding).
+
+    Raises
+    ------
+    ValueError
+        Non-unit, zero or infinite quaternions, non-finite ``t``, or shapes that do not
+        broadcast (the message names the argument).
+    """
+    q0, q1 = _real(q0, "q0"), _real(q1, "q1")
+    _check_last(q0, 4, "q0")
+    _check_last(q1, 4, "q1")
+    check_unit(q0, "q0")
+    check_unit(q1, "q1")
+    t = _v.vectors(t, "t", width=None, ndim=None)
+    q0, q1, tt = _broadcast(("q0", q0), ("q1", q1), ("t", t[..., None]))
+    s = np.where(np.sum(q0 * q1, axis=-1, keepdims=True) < 0, -1.0, 1.0)
+    q1 = s * q1
+    om = 2.0 * np.arctan2(
+        np.linalg.norm(q0 - q1, axis=-1, keepdims=True),
+        np.linalg.norm(q0 + q1, axis=-1, keepdims=True),
+    )
+    small = om < 1e-6
+    with np.errstate(invalid="ignore", divide="ignore"):
+        so = np.sin(np.where(small, 1.0, om))
+        out = np.where(
+            small,
+            (1.0 - tt) * q0 + tt * q1,
+            (np.sin((1.0 - tt) * om) * q0 + np.sin(tt * om) * q1) / so,
+        )
+        return out / np.linalg.norm(out, axis=-1, keepdims=True)
 
 
 def from_scipy(rot) -> np.ndarray:

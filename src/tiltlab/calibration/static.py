@@ -28,14 +28,17 @@ References
 
 from __future__ import annotations
 
+import warnings
 from typing import NamedTuple
 
 import numpy as np
 import xarray as xr
 
 from .. import _validate as _v
+from .. import units as _units
 from ..dsp import still_mask
 from ..intervals import intervals_to_mask, mask_to_intervals
+from ..quality import QualityWarning
 from ._util import CalibrationError, read_in, vec3
 
 __all__ = [
@@ -108,8 +111,22 @@ def static_intervals_from_trigger(
     return np.column_stack([starts[ok], stops[ok]]).astype(np.int64).reshape(-1, 2)
 
 
+#: Largest gyroscope offset (norm, °/s) that :func:`robust_gyro_offset` accepts by
+#: default. Datasheet zero-rate-output tolerances of MEMS gyroscopes are ±1 to ±20 °/s
+#: per axis (e.g. MPU-6050 ±20, MPU-9250 ±5, BMI160 ±3 °/s), i.e. at most about
+#: √3 · 20 ≈ 35 °/s in norm; Fayat et al.'s 5th–95th percentiles are −22.6 to 10.5 °/s.
+MAX_GYRO_OFFSET_DEG_S: float = 40.0
+
+
 def robust_gyro_offset(
-    gyr, fs: float | None = None, *, window_s: float = 0.5, quantile: float = 0.2
+    gyr,
+    fs: float | None = None,
+    *,
+    window_s: float = 0.5,
+    quantile: float = 0.2,
+    units: str | None = None,
+    max_offset_deg_s: float | None = MAX_GYRO_OFFSET_DEG_S,
+    on_rotation: str = "warn",
 ) -> np.ndarray:
     """First-pass gyroscope offset from the quietest windows of a recording.
 
@@ -118,6 +135,19 @@ def robust_gyro_offset(
     the per-axis median of their samples is returned. Variance does not depend on the
     offset, so this works for offsets of tens of °/s, and it needs only ``quantile`` of
     the record to be still. Windows holding a non-finite sample (a gap) are left out.
+
+    Sustained rotation is flagged. A steady rotation (an animal circling, a turntable)
+    is as quiet as a sensor at rest: its windows have the same low variance, and from
+    the gyroscope alone nothing tells a constant rate from an offset (the accelerometer
+    does not either for a rotation about the vertical). What does is the size: a
+    MEMS gyroscope's offset is bounded by its datasheet tolerance, so an estimate whose
+    norm exceeds ``max_offset_deg_s`` (default :data:`MAX_GYRO_OFFSET_DEG_S`, 40 °/s)
+    is taken for rotation during the quietest windows — a session with no still
+    period — whose removal would erase the movement (and make every sample look
+    immobile). It gives a :class:`~tiltlab.quality.QualityWarning` saying so
+    (``on_rotation="warn"``, the default, since the estimate is also the first pass of
+    :func:`detect_static` and of the ``"auto"`` offsets of :mod:`tiltlab.behavior` and
+    :mod:`tiltlab.cohort`), or a :class:`CalibrationError` (``on_rotation="raise"``).
 
     Parameters
     ----------
@@ -130,15 +160,44 @@ def robust_gyro_offset(
         Window length (s).
     quantile : float
         Fraction of the windows (the quietest) taken as still, in (0, 1].
+    units : str, optional
+        Units of a plain-array ``gyr`` (``"deg/s"`` or ``"rad/s"``), used only for the
+        plausibility check; labelled input carries its own. A plain array without
+        ``units`` is checked as if in °/s, which never refuses a true offset given in
+        rad/s (its numbers are smaller) but may miss a rotation given in rad/s.
+    max_offset_deg_s : float or None
+        Largest plausible offset norm (°/s); ``None`` (or ``inf``) disables the check,
+        e.g. for a gyroscope known to have a larger offset.
+    on_rotation : {"warn", "raise"}
+        What an estimate above ``max_offset_deg_s`` gives: a warning (the estimate is
+        still returned) or an error.
 
     Returns
     -------
     ndarray (3,)
         The offset, in the units of ``gyr``.
+
+    Raises
+    ------
+    CalibrationError
+        A recording shorter than one window, windows that all hold a gap, or, with
+        ``on_rotation="raise"``, an estimate larger than ``max_offset_deg_s``
+        (sustained rotation; the message gives the rate).
+
+    Warns
+    -----
+    tiltlab.quality.QualityWarning
+        An estimate larger than ``max_offset_deg_s`` (``on_rotation="warn"``).
     """
-    s = _v.signal(gyr, "gyr", fs=fs, allow_nan=True)
+    s = _v.signal(gyr, "gyr", fs=fs, units=units, allow_nan=True)
     window_s = _v.positive(window_s, "window_s")
     quantile = _v.fraction(quantile, "quantile", open_low=True)
+    if max_offset_deg_s is not None:
+        max_offset_deg_s = _v.positive(
+            max_offset_deg_s, "max_offset_deg_s", allow_inf=True
+        )
+    if on_rotation not in ("warn", "raise"):
+        raise ValueError(f"on_rotation must be 'warn' or 'raise', got {on_rotation!r}")
     g = s.values
     w = max(int(round(window_s * s.fs)), 2)
     nw = g.shape[0] // w
@@ -156,7 +215,24 @@ def robust_gyro_offset(
             "estimate a gyro offset"
         )
     quiet = ok & (var <= np.quantile(var[ok], quantile))
-    return np.median(blocks[quiet].reshape(-1, 3), axis=0)
+    offset = np.median(blocks[quiet].reshape(-1, 3), axis=0)
+    if max_offset_deg_s is not None:
+        factor = 1.0 if s.units is None else _units.conversion_factor(s.units, "deg/s")
+        rate = float(np.linalg.norm(offset)) * factor
+        if rate > max_offset_deg_s:
+            msg = (
+                f"gyr: even the quietest {window_s:g}-s windows rotate steadily at "
+                f"{rate:.3g} °/s, more than a MEMS gyroscope offset can be "
+                f"(max_offset_deg_s = {max_offset_deg_s:g} °/s): this looks like "
+                "sustained rotation (e.g. circling, or no still period at all), not a "
+                "sensor offset, and removing it would erase the movement. Estimate "
+                "the offset from a still recording and pass it explicitly, or raise "
+                "max_offset_deg_s if the sensor really has this offset"
+            )
+            if on_rotation == "raise":
+                raise CalibrationError(msg)
+            warnings.warn(msg, QualityWarning, stacklevel=2)
+    return offset
 
 
 def detect_static(

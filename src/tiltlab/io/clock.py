@@ -56,6 +56,13 @@ GAP_POLICIES: tuple[str, ...] = ("raise", "nan")
 #: across; a longer one is a real gap.
 MAX_GAP: float = 5.0
 
+#: Largest fraction of the samples of a regridded recording that ``gaps="nan"`` may
+#: leave missing (NaN). A grid that would be mostly NaN does not come from a logger
+#: that dropped samples but from a corrupted timestamp or a reset clock (one bad time
+#: value 20 000 s late turns 1000 rows at 100 Hz into 2 001 000 samples, 99.95 % NaN),
+#: so the file is refused with the time jump named (:func:`check_missing_fraction`).
+MAX_MISSING_FRACTION: float = 0.5
+
 #: A time column whose first sample lies between these many seconds after 1970-01-01
 #: (1980 to 2100) holds epoch times.
 _EPOCH_RANGE = (10 * 365.25 * 86400, 130 * 365.25 * 86400)
@@ -269,6 +276,52 @@ def raise_gaps(
     )
 
 
+def check_missing_fraction(
+    time: np.ndarray,
+    n_grid: int,
+    n_missing: int,
+    fs: float,
+    column: str,
+    where: str,
+    gap_idx: np.ndarray | None = None,
+) -> None:
+    """Refuse a regridding (``gaps="nan"``) that would leave more than
+    :data:`MAX_MISSING_FRACTION` of the ``n_grid`` samples missing.
+
+    Parameters
+    ----------
+    time : numpy.ndarray, shape (N,)
+        The time column, in seconds (strictly increasing).
+    n_grid, n_missing : int
+        Samples of the uniform grid at ``fs``, and how many of them would be NaN.
+    fs : float
+        Grid rate (Hz).
+    column, where : str
+        The time column's name and a prefix (the file) for the message.
+    gap_idx : numpy.ndarray, optional
+        The steps ``time[i] → time[i+1]`` that are gaps; default every step.
+
+    Raises
+    ------
+    tiltlab.schema.RecordingError
+        Naming the fraction and the longest time jump with its data rows.
+    """
+    if n_grid <= 0 or n_missing <= MAX_MISSING_FRACTION * n_grid:
+        return
+    steps = np.diff(time)
+    idx = np.arange(steps.size) if gap_idx is None else np.asarray(gap_idx)
+    i = int(idx[np.argmax(steps[idx])]) if idx.size else int(np.argmax(steps))
+    raise schema.RecordingError(
+        f"{where}time column {column!r}: filling its gaps with NaN would leave "
+        f"{n_missing} of {n_grid} samples at {fs:.6g} Hz missing "
+        f"({100.0 * n_missing / n_grid:.4g} %, more than the "
+        f"{100.0 * MAX_MISSING_FRACTION:g} % allowed). The longest time jump is "
+        f"{steps[i]:.10g} s, from t = {time[i]:.10g} s (data row {i}) to "
+        f"t = {time[i + 1]:.10g} s (data row {i + 1}): a corrupted timestamp or a "
+        "reset clock? Repair or remove the bad rows, or split the file at the jump"
+    )
+
+
 def uniform_grid(start: float, stop: float, fs: float) -> np.ndarray:
     """``start + k / fs`` for every k with the time inside ``[start, stop]``."""
     n = int(np.floor((stop - start) * fs * (1 + 1e-12) + 1e-9)) + 1
@@ -355,7 +408,8 @@ def place_on_grid(
     (``"nan"``); return the time, the columns and the number of samples inserted.
 
     A clock that is not on a ``k / fs`` grid (jitter, drift) is refused with a hint to
-    read it with ``clock="resample"``.
+    read it with ``clock="resample"``. With ``"nan"``, a grid that would be more than
+    :data:`MAX_MISSING_FRACTION` missing is refused (:func:`check_missing_fraction`).
     """
     segs = _validate.segments(time, fs)
     if len(segs) <= 1:
@@ -386,6 +440,7 @@ def place_on_grid(
             "estimate(..., gaps='segments'))"
         )
     n = int(k[-1] + 1)
+    check_missing_fraction(time, n, n - k.size, fs, column, where)
     full_time = time[0] + np.arange(n) / fs
     full_time[k] = time
     out = {}

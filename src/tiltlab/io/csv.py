@@ -117,21 +117,66 @@ def _flat(name: Any) -> str:
     return str(name)
 
 
-def _numeric(values: pd.Series, name: str, path: Path) -> np.ndarray:
-    """A column as numbers, refusing text and empty fields with the data row."""
+def _numeric(values: pd.Series, name: str, path: Path, raw_text=None) -> np.ndarray:
+    """A column as numbers, refusing text, missing-value markers and empty fields
+    with the data row. ``raw_text(row)``, if given, returns the field as written in
+    the file (pandas has already turned markers such as ``NaN`` or ``NA`` into NaN)."""
     num = pd.to_numeric(values, errors="coerce")
     bad = num.isna().to_numpy()
     if bad.any():
         row = int(np.argmax(bad))
         text = values.iat[row]
-        if pd.isna(text) or str(text).strip() == "":
+        if pd.isna(text) and raw_text is not None:
+            text = raw_text(row)
+        if text is None or pd.isna(text) or str(text).strip() == "":
             raise ReadError(
                 f"{path}: empty field in column {name!r}, data row {row} (truncated file?)"
             )
+        if pd.isna(pd.to_numeric(pd.Series([str(text).strip()]), errors="coerce")[0]):
+            if str(text).strip().lower().lstrip("+-#") in _NA_MARKERS:
+                n_bad = int(bad.sum())
+                raise ReadError(
+                    f"{path}: missing value {str(text)!r} in column {name!r}, data row "
+                    f"{row} ({n_bad} missing value{'s' if n_bad != 1 else ''} in the "
+                    "column): read_csv takes every row as a measured sample. Drop the "
+                    "rows without a measurement (with a time column, the gap they "
+                    "leave can be kept as NaN rows: gaps='nan')"
+                )
         raise ReadError(
             f"{path}: non-numeric value {text!r} in column {name!r}, data row {row}"
         )
     return num.to_numpy()
+
+
+#: Texts that pandas reads as a missing value (lower case, sign and '#' stripped).
+_NA_MARKERS = frozenset(
+    {"nan", "na", "n/a", "null", "none", "nat", "<na>", "1.#ind", "1.#qnan", "ind"}
+)
+
+
+def _raw_field(path: Path, kwargs: Mapping[str, Any], column: str):
+    """A function ``row -> str``: the field of ``column`` as written in the file (read
+    again without missing-value conversion; used for error messages only)."""
+
+    def get(row: int):
+        try:
+            df = pd.read_csv(
+                path,
+                **{
+                    **kwargs,
+                    "dtype": str,
+                    "keep_default_na": False,
+                    "na_filter": False,
+                },
+            )
+        except (pd.errors.ParserError, ValueError, TypeError, UnicodeDecodeError):
+            return None
+        df.columns = [_flat(c) for c in df.columns]
+        if column not in df.columns or row >= len(df):
+            return None
+        return df[column].iat[row]
+
+    return get
 
 
 def read_frame(
@@ -144,6 +189,8 @@ def read_frame(
     """Read the ``wanted`` columns of a CSV: numbers (integers kept as integers), or
     the raw values for the columns in ``text``. A header of several rows is flattened
     (levels joined with ``/``)."""
+    if path.is_dir():
+        raise ReadError(f"{path}: is a directory, not a file")
     if not path.is_file():
         raise ReadError(f"{path}: no such file")
     header = read_kwargs.get("header", "infer")
@@ -177,7 +224,11 @@ def read_frame(
         col = df[c]
         if isinstance(col, pd.DataFrame):
             raise ReadError(f"{path}: column {c!r} appears more than once")
-        out[c] = col.to_numpy() if c in text else _numeric(col, c, path)
+        out[c] = (
+            col.to_numpy()
+            if c in text
+            else _numeric(col, c, path, _raw_field(path, kwargs, c))
+        )
     return out
 
 
@@ -285,7 +336,11 @@ def read_csv(
         samples: steps longer than 1.5 periods on a grid clock, longer than
         ``max_gap`` periods on a resampled one). ``"raise"`` (default) refuses the file
         with the gaps located; ``"nan"`` puts NaN rows on the grid in their place, keeps
-        a description in ``attrs['gaps']`` and validates with ``allow_nan``.
+        a description in ``attrs['gaps']`` and validates with ``allow_nan``. A grid
+        that would be more than half missing
+        (:data:`tiltlab.io.clock.MAX_MISSING_FRACTION`, 50 %) is refused with the
+        longest time jump and its data rows named: such a grid comes from a
+        corrupted timestamp or a reset clock, not from dropped samples.
     check_units : bool, optional
         Passed to :func:`tiltlab.schema.make_recording` (default True). A
         :class:`~tiltlab.quality.UnitCheckError` names the switch as the options were
@@ -307,14 +362,17 @@ def read_csv(
     Raises
     ------
     ReadError
-        If the file is missing or unreadable, or lacks a mapped column (the message
-        names it and lists the file's columns).
+        If the file is missing (or is a directory) or unreadable, or lacks a mapped
+        column (the message names it and lists the file's columns), or a mapped
+        column holds text, an empty field or a missing-value marker such as ``NaN``
+        (named as such, with its data row).
     ValueError
         If the mapping is incomplete or inconsistent, or the sampling rate implausible.
     RecordingError
         If the data break the Recording contract, if the time column skips samples
-        (unless ``gaps="nan"``), or if it is not on a regular grid with
-        ``clock="grid"`` (the message suggests ``clock="resample"``).
+        (unless ``gaps="nan"``; with it, if more than half of the grid would be
+        missing), or if it is not on a regular grid with ``clock="grid"`` (the
+        message suggests ``clock="resample"``).
 
     Examples
     --------
@@ -478,8 +536,15 @@ def _apply_clock(
     gap_idx = _clock.gap_steps(time, fs_est, m["max_gap"])
     if gap_idx.size and m["gaps"] == "raise":
         _clock.raise_gaps(time, gap_idx, fs_est, m["max_gap"], tcol, where, style)
-    _clock.warn_if_downsampled(fs, fs_est, str(path))
     grid = _clock.uniform_grid(time[0], time[-1], fs)
+    if gap_idx.size:  # grid samples strictly inside the gaps become NaN
+        inside = np.searchsorted(
+            grid, time[gap_idx + 1], side="left"
+        ) - np.searchsorted(grid, time[gap_idx], side="right")
+        _clock.check_missing_fraction(
+            time, grid.size, int(inside.sum()), fs, tcol, where, gap_idx
+        )
+    _clock.warn_if_downsampled(fs, fs_est, str(path))
     for var, v in get.items():
         get[var] = _clock.interpolate(time, v, grid, gap_idx, quaternion=var == "q_ref")
     extra_attrs["resampled"] = _clock.describe_resampling(time, grid.size, fs)

@@ -8,7 +8,31 @@ import numpy as np
 import xarray as xr
 
 from .. import _validate, schema
-from ._common import PathLike, _read_table
+from ._common import PathLike, ReadError, _read_table
+
+
+def _existing_file(path: PathLike) -> None:
+    """Refuse a directory given where a file is expected (a missing file is refused
+    by the table reader)."""
+    if Path(path).is_dir():
+        raise ReadError(f"{path}: is a directory, not a file")
+
+
+def _counter(path: PathLike, column) -> np.ndarray:
+    """The acquisition counter as int64; a non-integer value (a corrupted row) is an
+    error naming the row, never cut to an integer."""
+    values = column.to_numpy()
+    if values.dtype.kind == "f":
+        frac = values != np.floor(values)
+        if frac.any():
+            i = int(np.argmax(frac))
+            raise ReadError(
+                f"{path}: counter must hold whole sample counts, got {values[i].item()!r} at "
+                f"data row {i} ({int(frac.sum())} non-integer value"
+                f"{'s' if frac.sum() != 1 else ''}): a corrupted row? Repair or "
+                "remove it"
+            )
+    return values.astype(np.int64)
 
 
 def read_fayat_imu(
@@ -33,12 +57,20 @@ def read_fayat_imu(
     References
     ----------
     .. [1] R. Fayat et al., Sensors 21(18):6318, 2021. doi:10.3390/s21186318
+
+    Raises
+    ------
+    ReadError
+        A missing file (or a directory), a truncated or unreadable table, or a
+        ``counter`` value that is not a whole number (the data row is named; it is
+        never cut to an integer).
     """
+    _existing_file(path)
     df = _read_table(
         path, ["counter", "ax", "ay", "az", "gx", "gy", "gz"], final_newline=True
     )
     counter_rate = _validate.positive(counter_rate, "counter_rate")
-    counter = df["counter"].to_numpy(np.int64)
+    counter = _counter(path, df["counter"])
     time = (counter - counter[0]) / counter_rate
     return schema.make_recording(
         df[["ax", "ay", "az"]].to_numpy(),
@@ -81,7 +113,13 @@ def read_fayat_tumble(
     recorded as the variables' ``range`` attribute (the full scale), so that the samples
     clipped while the sensor was turned over are found
     (:func:`tiltlab.quality.saturation`).
+
+    Raises
+    ------
+    ReadError
+        A missing file (or a directory), or a truncated or unreadable table.
     """
+    _existing_file(path)
     df = _read_table(
         path,
         ["ax", "ay", "az", "gx", "gy", "gz", "time"],

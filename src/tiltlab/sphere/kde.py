@@ -626,10 +626,40 @@ def _rows(v, name: str) -> np.ndarray:
 
 
 def slerp(a, b, t) -> np.ndarray:
-    r"""Points at fraction t along the orthodromic arcs a→b (rows), :math:`\frac{\sin((1-t)\omega)a+\sin(t\omega)b}{\sin\omega}`."""
+    r"""Points at fraction t along the orthodromic arcs a→b (rows), :math:`\frac{\sin((1-t)\omega)a+\sin(t\omega)b}{\sin\omega}`.
+
+    Parameters
+    ----------
+    a, b : array_like, shape (..., 3)
+        Directions (normalised here; zero or non-finite rows are an error).
+    t : array_like
+        Fractions along the arcs (finite), broadcast with the rows.
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., 3)
+        Unit vectors; identical ``a`` and ``b`` give that direction for every ``t``.
+
+    Raises
+    ------
+    ValueError
+        When ``a`` and ``b`` are opposite directions (angle within 10⁻¹² rad of π) in
+        some row: every great circle through them is a shortest arc, so the path is
+        undefined (no direction is chosen arbitrarily; before, the point jumped from
+        ``a`` to ``b`` through NaN at t = 1/2). The message names the first row.
+    """
     a, b = _rows(a, "a"), _rows(b, "b")
     t = _validate.vectors(t, "t", width=None, ndim=None)[..., None]
     om = angle(a, b)[..., None]
+    opposite = (np.sin(om) <= 1e-12) & (np.sum(a * b, axis=-1, keepdims=True) < 0)
+    if np.any(opposite):
+        k = np.argwhere(opposite[..., 0])
+        where = f" (first at index {tuple(int(i) for i in k[0])})" if k.size else ""
+        raise ValueError(
+            f"a and b are opposite directions in {int(opposite.sum())} row(s){where}: "
+            "the great-circle arc between antipodal points is not unique, so slerp is "
+            "undefined there"
+        )
     with np.errstate(invalid="ignore", divide="ignore"):
         so = np.sin(om)
         p = np.where(
@@ -681,7 +711,9 @@ def mkde(
     max_gap : steps longer than this (s) are dropped (data gaps).
     kernel, cell_deg, tol, quadrature : as in :func:`kde`.
 
-    At most 5·10⁷ kernels are placed (beyond that, an error names ``step``).
+    At most 5·10⁷ kernels are placed (beyond that, an error names ``step``). Two
+    successive samples in opposite directions are an error naming them (the arc
+    between antipodal points is not unique, see :func:`slerp`).
     """
     x, t, _ = _series(vectors, fs, times)
     n = x.shape[0]
@@ -698,6 +730,14 @@ def mkde(
     if a.shape[0] == 0:
         raise ValueError("every step is longer than max_gap")
     om = angle(a, b)
+    opposite = (np.sin(om) <= 1e-12) & (np.sum(a * b, axis=-1) < 0)
+    if np.any(opposite):
+        i = int(np.flatnonzero(keep)[np.argmax(opposite)])
+        raise ValueError(
+            f"vectors: samples {i} and {i + 1} are opposite directions: the path "
+            "between them (a half-turn) has no defined great circle; drop the bad "
+            "sample or give a max_gap that excludes that step"
+        )
     m = np.maximum(1, np.ceil(om / step))
     if m.sum() > _MAX_KERNELS:
         raise ValueError(

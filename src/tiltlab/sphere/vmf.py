@@ -389,6 +389,19 @@ def vmf_bootstrap(
     array. ``block_s`` gives the block length in seconds instead of samples
     (``block = round(block_s · fs)``), with ``fs`` read from the data (or given for a
     plain array; a missing or contradictory ``fs`` is an error).
+
+    Returns
+    -------
+    ConfidenceCone
+
+    Raises
+    ------
+    ValueError
+        Fewer than 2 samples (or fewer than 2 directions with non-zero weight), or a
+        block bootstrap with fewer than 2 blocks (``block > N / 2``): every replicate
+        would then be the data themselves (up to a circular shift), and the cone a
+        meaningless 0°. Also bad ``level``, ``n_boot``, ``block``, ``block_s`` or
+        weights, and data without a mean direction (:func:`vmf_fit`).
     """
     sig = _read(x, name="x", fs=fs, need_fs=block_s is not None)
     x = as_unit_vectors(sig.values, "x")
@@ -401,6 +414,19 @@ def vmf_bootstrap(
             raise ValueError("give block (samples) or block_s (seconds), not both")
         block = max(1, int(round(_validate.positive(block_s, "block_s") * sig.fs)))
     block = _validate.integer(block, "block", minimum=1)
+    n_used = n if w is None else int(np.count_nonzero(w))
+    if n_used < 2:
+        what = "sample" if w is None else "direction with non-zero weight"
+        raise ValueError(
+            f"x has {n_used} {what}{'s' if n_used != 1 else ''}: a bootstrap needs at "
+            "least 2 (every replicate would be the data themselves, a 0° cone)"
+        )
+    if w is None and 1 < block and n < 2 * block:
+        raise ValueError(
+            f"block = {block} samples leaves fewer than 2 blocks in the {n} samples of "
+            f"x: every replicate would be the whole series (a 0° cone); use a block of "
+            f"at most {n // 2} samples"
+        )
     rng = np.random.default_rng(rng)
     fit = vmf_fit(x, w)
     nb_ = int(n_boot)
@@ -451,6 +477,27 @@ def vmf_bootstrap(
 # ---------------------------------------------------------------------------
 
 
+def _facet_radius(mesh: SphereMesh) -> np.ndarray:
+    """Per facet, the largest chord from its (unit) centroid to its corners."""
+    c = mesh.centroids / np.linalg.norm(mesh.centroids, axis=1, keepdims=True)
+    corners = mesh.vertices[mesh.faces]  # (F, 3, 3)
+    return np.linalg.norm(corners - c[:, None, :], axis=2).max(axis=1)
+
+
+def _map_mesh(tmap: xr.Dataset, mesh: SphereMesh | None) -> SphereMesh | None:
+    """The mesh a tilt-map Dataset was counted on (given, or rebuilt from its
+    ``n_vertices`` attribute), or None when it cannot be known."""
+    n_faces = tmap.sizes.get("facet")
+    if mesh is None and "n_vertices" in tmap.attrs:
+        try:
+            mesh = sphere_mesh(int(tmap.attrs["n_vertices"]))
+        except (TypeError, ValueError):
+            return None
+    if mesh is not None and mesh.n_faces == n_faces:
+        return mesh
+    return None
+
+
 def mean_tilt_point(tmap, mesh: SphereMesh | None = None) -> VMFFit:
     r"""Average tilt point of a map (Fayat et al. §2.8): vMF fit of the facet centroids weighted by their counts.
 
@@ -459,10 +506,40 @@ def mean_tilt_point(tmap, mesh: SphereMesh | None = None) -> VMFFit:
     tmap : xarray.Dataset (from :func:`~tiltlab.sphere.tilt_map`) or array (F,)
         Samples (or time) per facet.
     mesh : SphereMesh, optional
-        Needed when ``tmap`` is an array (default the 5000-vertex mesh).
+        Needed when ``tmap`` is an array (default the 5000-vertex mesh). For a Dataset
+        it defaults to the mesh named by its ``n_vertices`` attribute.
+
+    Returns
+    -------
+    VMFFit
+
+    Raises
+    ------
+    ValueError
+        As :func:`vmf_fit` when the map has no mean direction: a map symmetric enough
+        that its mean resultant length :math:`\bar R` is within the facets' size. A
+        count stands for samples anywhere in its facet, so replacing them by the
+        centroid moves each by at most the facet radius :math:`\rho_i` (largest chord
+        from the centroid to a corner); the resultant of the samples themselves may
+        then be anywhere within :math:`\bar\rho = \sum_i w_i\rho_i / \sum_i w_i` of the
+        map's. When :math:`\bar R \le \bar\rho` even its direction is not determined
+        by the map (e.g. a uniform map, whose :math:`\bar R` of about 10⁻⁶ only
+        reflects the mesh's irregularity): an error, as :func:`vmf_fit` gives for a
+        zero resultant, rather than an arbitrary direction. For a Dataset whose mesh
+        is unknown, :math:`\rho_i` is estimated from the facet area :math:`A_i` as the
+        circumradius of an equilateral triangle, :math:`\sqrt{4A_i/(3\sqrt3)}`.
     """
     if isinstance(tmap, xr.Dataset):
         c, w = tmap["centroid"].values, tmap["count"].values
+        used = _map_mesh(tmap, mesh)
+        if used is not None:
+            radius = _facet_radius(used)
+        elif "area" in tmap.coords:
+            radius = np.sqrt(
+                4.0 * np.asarray(tmap["area"].values, float) / (3 * np.sqrt(3))
+            )
+        else:
+            radius = None
     else:
         mesh = sphere_mesh() if mesh is None else mesh
         c, w = mesh.centroids, np.asarray(tmap, float)
@@ -470,7 +547,21 @@ def mean_tilt_point(tmap, mesh: SphereMesh | None = None) -> VMFFit:
             raise ValueError(
                 f"tmap has shape {w.shape}, mesh has {mesh.n_faces} facets"
             )
-    return vmf_fit(c, _weights(w, c.shape[0], "tmap"))
+        radius = _facet_radius(mesh)
+    w = _weights(w, c.shape[0], "tmap")
+    if radius is not None:
+        x = as_unit_vectors(c, "centroid")
+        rbar = float(np.linalg.norm(w @ x)) / float(w.sum())
+        rho = float(w @ radius) / float(w.sum())
+        if rbar <= rho:
+            raise ValueError(
+                f"tmap: the map has no mean direction: its mean resultant length "
+                f"R̄ = {rbar:.3g} is within the facets' size ({rho:.3g}, the mean facet "
+                "radius), so the direction of its resultant is set by the mesh, not by "
+                "the data (a map symmetric about the centre of the sphere, e.g. "
+                "uniform); vmf_fit raises likewise for a zero resultant"
+            )
+    return vmf_fit(c, w)
 
 
 def sagittal_angle(mu, lesion_side: str = "left") -> np.ndarray:

@@ -27,6 +27,19 @@ likely (:math:`2^{n}` configurations) and :math:`T^+ = \sum_{d_i > 0} r_i` has
 :math:`P(T^+ = s) = c(2s) / 2^n` with :math:`c^{(j)}(t) = c^{(j-1)}(t) +
 c^{(j-1)}(t - w_j)`.
 
+Exact range
+-----------
+The counts are float64 numbers and the recursion fills an array of
+:math:`(n_1 + 1) \times (\sum w + 1)` cells (Mann–Whitney) or :math:`\sum w + 1`
+cells (signed rank). The exact method is used only where both stay sound: at most
+:data:`EXACT_MAX_PAIRS` (1000) non-zero differences for the signed-rank test (the
+:math:`2^n` sign vectors overflow float64 beyond :math:`n = 1023`, which made the
+p-value NaN), and at most :data:`EXACT_MAX_CELLS` (2·10⁷) cells for Mann–Whitney
+(computed for the smaller group; :math:`\binom{N}{n_1}` then never overflows). Beyond
+that range — also when ``method="exact"`` was asked for — the asymptotic p-value is
+returned: ``method`` says ``"asymptotic-cc"`` (or ``"asymptotic"``) and ``note`` says
+why (with a :class:`RuntimeWarning` when the exact method was requested explicitly).
+
 Asymptotic p-values (large groups) use the tie-corrected normal approximation with a
 continuity correction of 1/2:
 
@@ -52,6 +65,7 @@ References
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 from functools import lru_cache
 from math import comb
@@ -65,6 +79,8 @@ from .. import _validate
 __all__ = [
     "ALTERNATIVES",
     "ZERO_METHODS",
+    "EXACT_MAX_PAIRS",
+    "EXACT_MAX_CELLS",
     "TestResult",
     "mann_whitney",
     "wilcoxon_signed_rank",
@@ -79,6 +95,10 @@ ALTERNATIVES = ("greater", "less", "two-sided")
 #: Zero-difference rules of the signed-rank test.
 ZERO_METHODS = ("wilcox", "pratt")
 _METHODS = ("auto", "exact", "asymptotic")
+#: Most non-zero differences of an exact signed-rank test (2^n must fit a float64).
+EXACT_MAX_PAIRS = 1000
+#: Most cells of the subset-sum array of an exact Mann–Whitney test (160 MB).
+EXACT_MAX_CELLS = 20_000_000
 
 
 @dataclass(frozen=True)
@@ -106,6 +126,9 @@ class TestResult:
         Zero differences (signed-rank test; 0 for Mann–Whitney).
     zero_method : str
         The zero rule of the signed-rank test (``""`` for Mann–Whitney).
+    note : str
+        Why the method differs from the one asked for (an exact test beyond the exact
+        range, see the module docstring); ``""`` otherwise.
     """
 
     __test__ = False  # not a pytest class
@@ -120,6 +143,7 @@ class TestResult:
     ties: bool
     n_zero: int = 0
     zero_method: str = ""
+    note: str = ""
 
 
 # ------------------------------------------------------------------ argument checks
@@ -210,16 +234,45 @@ def mwu_null_distribution(n1: int, n2: int) -> np.ndarray:
     -------
     numpy.ndarray
         Probabilities, summing to 1.
+
+    Raises
+    ------
+    ValueError
+        Group sizes beyond the exact range (:data:`EXACT_MAX_CELLS`; the distribution
+        is counted for the smaller group, as it is the same for both).
     """
     n1 = _validate.integer(n1, "n1", minimum=1)
     n2 = _validate.integer(n2, "n2", minimum=1)
-    c = _mwu_counts_noties(n1, n2)
+    ranks = np.arange(1, n1 + n2 + 1)
+    if _mwu_cells(ranks, n1) <= EXACT_MAX_CELLS:
+        c = _mwu_counts_noties(n1, n2)
+    elif _mwu_cells(ranks, n2) <= EXACT_MAX_CELLS:
+        c = _mwu_counts_noties(n2, n1)  # P(U = u) is symmetric in n1, n2
+    else:
+        raise ValueError(
+            f"mwu_null_distribution: n1 = {n1} and n2 = {n2} are beyond the exact "
+            f"range (more than EXACT_MAX_CELLS = {EXACT_MAX_CELLS:.3g} cells); use the "
+            "normal approximation"
+        )
     return c / c.sum()
 
 
 def signed_rank_null_distribution(n: int) -> np.ndarray:
-    r"""Exact null probabilities :math:`P(T^+ = t)`, :math:`t = 0,\dots,n(n+1)/2`."""
+    r"""Exact null probabilities :math:`P(T^+ = t)`, :math:`t = 0,\dots,n(n+1)/2`.
+
+    Raises
+    ------
+    ValueError
+        ``n`` above :data:`EXACT_MAX_PAIRS` (the :math:`2^n` sign vectors overflow
+        float64).
+    """
     n = _validate.integer(n, "n", minimum=1)
+    if n > EXACT_MAX_PAIRS:
+        raise ValueError(
+            f"signed_rank_null_distribution: n = {n} is beyond the exact range "
+            f"(EXACT_MAX_PAIRS = {EXACT_MAX_PAIRS}: the 2^{n} sign vectors overflow "
+            "float64); use the normal approximation"
+        )
     c = _signed_rank_counts_noties(n)
     return c / c.sum()
 
@@ -252,6 +305,28 @@ def _tie_term(ranks: np.ndarray) -> float:
     return float(np.sum(t.astype(float) ** 3 - t))
 
 
+def _beyond_exact(test: str, why: str, requested: str) -> str:
+    """The note of an exact test replaced by the normal approximation (and a warning
+    when ``method="exact"`` was asked for explicitly)."""
+    note = (
+        f"exact null distribution not computed ({why}); normal approximation used "
+        "instead"
+    )
+    if requested == "exact":
+        warnings.warn(
+            f"{test}: method='exact' is beyond the exact range ({why}); the asymptotic "
+            "p-value is returned (result.method and result.note say so)",
+            RuntimeWarning,
+            stacklevel=3,
+        )
+    return note
+
+
+def _mwu_cells(w: np.ndarray, k: int) -> int:
+    """Cells of :func:`_subset_sum_counts` for ``k``-subsets of the weights ``w``."""
+    return (k + 1) * (int(np.sort(w)[::-1][:k].sum()) + 1)
+
+
 # ------------------------------------------------------------------ Mann–Whitney
 
 
@@ -275,7 +350,9 @@ def mann_whitney(
         (:math:`P(X > Y) > 1/2`). No default: the direction must be stated.
     method : {"auto", "exact", "asymptotic"}
         ``"auto"`` is exact when :math:`\min(n_1, n_2) \le` ``exact_max_n`` (exact
-        conditional on the ties when there are ties), asymptotic otherwise.
+        conditional on the ties when there are ties), asymptotic otherwise. Beyond the
+        exact range (:data:`EXACT_MAX_CELLS`, see the module docstring) an exact
+        request gives the asymptotic p-value, with ``method`` and ``note`` saying so.
     exact_max_n : int
         Threshold of ``"auto"`` (8, scipy's rule, which reproduces the p-value
         lattice of Fayat et al.'s Tables A1–A7 for the 5-animal group).
@@ -293,6 +370,11 @@ def mann_whitney(
     ValueError
         Empty or non-finite samples, an unknown ``alternative`` or ``method``, or
         :math:`n_1 + n_2 < 3` (no one-sided p below 1/2 is attainable).
+
+    Warns
+    -----
+    RuntimeWarning
+        ``method="exact"`` beyond the exact range (the asymptotic p-value is returned).
 
     Notes
     -----
@@ -314,25 +396,45 @@ def mann_whitney(
     r1 = float(ranks[:n1].sum())
     u = r1 - n1 * (n1 + 1) / 2.0
     ties = bool(np.unique(ranks).size < ranks.size)
+    requested, note = method, ""
     if method == "auto":
         method = "exact" if min(n1, n2) <= exact_max_n else "asymptotic"
     if method == "exact":
-        if not ties:
-            counts = _mwu_counts_noties(n1, n2)
-            p = _tail_p(counts, int(round(u)), alternative)
-            label = "exact"
-        else:
-            w = np.rint(2 * ranks).astype(np.int64)
-            counts = _subset_sum_counts(w, n1)
-            p = _tail_p(counts, int(round(2 * r1)), alternative)
-            label = "exact-conditional"
+        w = np.rint(2 * ranks).astype(np.int64) if ties else np.arange(1, n1 + n2 + 1)
+        direct = _mwu_cells(w, n1)
+        swapped = _mwu_cells(w, n2) if direct > EXACT_MAX_CELLS else direct
+        if min(direct, swapped) > EXACT_MAX_CELLS:
+            method = "asymptotic"
+            note = _beyond_exact(
+                "mann_whitney",
+                f"n1 = {n1} and n2 = {n2} need {min(direct, swapped):.3g} cells, more "
+                f"than EXACT_MAX_CELLS = {EXACT_MAX_CELLS:.3g}",
+                requested,
+            )
+    if method == "exact":
+        if direct <= EXACT_MAX_CELLS:  # as always (the smaller work array otherwise)
+            if not ties:
+                counts = _mwu_counts_noties(n1, n2)
+                p = _tail_p(counts, int(round(u)), alternative)
+            else:
+                counts = _subset_sum_counts(w, n1)
+                p = _tail_p(counts, int(round(2 * r1)), alternative)
+        else:  # count the other group's subsets: W_y = total - W_x, direction flipped
+            flip = {"greater": "less", "less": "greater"}.get(alternative, alternative)
+            if not ties:
+                counts = _mwu_counts_noties(n2, n1)
+                p = _tail_p(counts, int(round(n1 * n2 - u)), flip)
+            else:
+                counts = _subset_sum_counts(w, n2)
+                p = _tail_p(counts, int(w.sum() - round(2 * r1)), flip)
+        label = "exact-conditional" if ties else "exact"
     else:
         nn = n1 + n2
         var = n1 * n2 / 12.0 * ((nn + 1) - _tie_term(ranks) / (nn * (nn - 1)))
         cc = 0.5 if continuity else 0.0
         p = _normal_p(u, n1 * n2 / 2.0, np.sqrt(max(var, 0.0)), alternative, cc)
         label = "asymptotic-cc" if continuity else "asymptotic"
-    return TestResult("mann-whitney", u, p, alternative, label, n1, n2, ties)
+    return TestResult("mann-whitney", u, p, alternative, label, n1, n2, ties, note=note)
 
 
 # ------------------------------------------------------------------ signed rank
@@ -364,7 +466,9 @@ def wilcoxon_signed_rank(
         then drops them (Pratt 1959).
     method : {"auto", "exact", "asymptotic"}
         ``"auto"`` is exact for :math:`n \le` ``exact_max_n`` non-zero differences
-        (exact conditional with ties or zeros), asymptotic otherwise.
+        (exact conditional with ties or zeros), asymptotic otherwise. Beyond
+        :data:`EXACT_MAX_PAIRS` (1000) non-zero differences an exact request gives the
+        asymptotic p-value, with ``method`` and ``note`` saying so.
     exact_max_n : int
         Threshold of ``"auto"`` (50, as scipy and R).
     continuity : bool
@@ -382,6 +486,12 @@ def wilcoxon_signed_rank(
         Empty, non-finite or unequal-length samples, an unknown ``alternative``,
         ``zero_method`` or ``method``, or fewer than 2 non-zero differences (no
         one-sided p below 1/2 is attainable).
+
+    Warns
+    -----
+    RuntimeWarning
+        ``method="exact"`` with more than :data:`EXACT_MAX_PAIRS` non-zero differences
+        (the asymptotic p-value is returned).
 
     Notes
     -----
@@ -421,8 +531,17 @@ def wilcoxon_signed_rank(
         )
     t_plus = float(ranks[dn > 0].sum())
     ties = bool(np.unique(ranks).size < ranks.size)
+    requested, note = method, ""
     if method == "auto":
         method = "exact" if n <= exact_max_n else "asymptotic"
+    if method == "exact" and n > EXACT_MAX_PAIRS:
+        method = "asymptotic"
+        note = _beyond_exact(
+            "wilcoxon_signed_rank",
+            f"{n} non-zero differences, more than EXACT_MAX_PAIRS = "
+            f"{EXACT_MAX_PAIRS}: the 2^{n} sign vectors overflow float64",
+            requested,
+        )
     if method == "exact":
         if not ties and not (zero_method == "pratt" and n_zero):
             p = _tail_p(_signed_rank_counts_noties(n), int(round(t_plus)), alternative)
@@ -438,7 +557,7 @@ def wilcoxon_signed_rank(
         p = _normal_p(t_plus, mu, np.sqrt(var), alternative, cc)
         label = "asymptotic-cc" if continuity else "asymptotic"
     out = (t_plus, p, alternative, label, n_pairs, n_pairs, ties, n_zero, zero_method)
-    return TestResult("wilcoxon", *out)
+    return TestResult("wilcoxon", *out, note=note)
 
 
 # ------------------------------------------------------------------ p-value lattices
