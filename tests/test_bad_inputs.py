@@ -3160,7 +3160,8 @@ cli(
         "--out",
         "{tmp}/m2.csv",
     ],
-    r"parquet",
+    r"--reader: invalid choice: 'parquet'",
+    usage=True,
 )
 cli("cohort-show-missing", ["cohort", "show", "{tmp}/none.nc"], r"none\.nc")
 cli(

@@ -45,8 +45,8 @@ def test_fetch_verifies_mirror(data_mirror, capsys):
 # --------------------------------------------------------------------------- generic CSV
 
 
-def _write_lab_csv(path, n=300, fs=100.0):
-    rng = np.random.default_rng(1)
+def _write_lab_csv(path, n=300, fs=100.0, seed=1):
+    rng = np.random.default_rng(seed)
     acc = rng.normal(0, 0.01, (n, 3)) + [0, 0, 1.0]
     gyr = rng.normal(0, 1.0, (n, 3))
     lines = ["t_ms;ax;ay;az;gx;gy;gz"] + [
@@ -415,9 +415,10 @@ def test_cohort_run_with_a_config_and_missing_manifest(study, capsys):
 
 def test_cohort_of_generic_csv_sessions(tmp_path, capsys):
     """A lab's own CSV files (time in ms) through init --reader csv, run and show."""
-    for subject in ("a1", "a2"):
+    for seed, subject in enumerate(("a1", "a2")):
         (tmp_path / "raw").mkdir(exist_ok=True)
-        _write_lab_csv(tmp_path / "raw" / f"{subject}_base.csv", n=1500)
+        # two animals, two recordings: identical files would be one recording twice
+        _write_lab_csv(tmp_path / "raw" / f"{subject}_base.csv", n=1500, seed=seed)
     mapping = tmp_path / "mapping.json"
     mapping.write_text(json.dumps(MAPPING))
     manifest = tmp_path / "manifest.csv"

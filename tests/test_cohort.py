@@ -499,7 +499,8 @@ def test_broad_trials_as_a_cohort_grouped_by_trial_type(data_mirror, tmp_path):
         rows.append(
             {
                 "session": f"broad{k:02d}",
-                "subject": "broad",
+                # one subject per trial: a subject in two groups is refused
+                "subject": f"trial{k:02d}",
                 "group": kind,
                 "timepoint": k,
                 "file": str(datasets.fetch(trials[k])),

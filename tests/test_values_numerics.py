@@ -463,3 +463,33 @@ def test_quaternion_functions_refuse_complex_input_by_name():
         ]:
             with pytest.raises(ValueError, match=rf"{name} holds complex numbers"):
                 call()
+
+
+def test_multi_file_regridding_to_mostly_nan_is_refused(tmp_path):
+    """One corrupted time stamp per stream (a jump of 1000 s at the end) would make the
+    merged grid 99 % NaN: the multi-file reader refuses it, naming the stream."""
+    import pandas as pd
+
+    from tiltlab import io
+
+    t = np.arange(500) / 100.0
+    t[-1] = 1000.0
+    rng = np.random.default_rng(0)
+    for name in ("acc", "gyr"):
+        base = [0.0, 0.0, 1.0] if name == "acc" else [0.0, 0.0, 0.0]
+        v = np.asarray(base) + 0.01 * rng.normal(size=(500, 3))
+        pd.DataFrame({"t": t, "x": v[:, 0], "y": v[:, 1], "z": v[:, 2]}).to_csv(
+            tmp_path / f"{name}.csv", index=False
+        )
+    files = {
+        v: {
+            "path": f"{v}.csv",
+            "columns": ["x", "y", "z"],
+            "time_column": "t",
+            "time_units": "s",
+            "units": u,
+        }
+        for v, u in (("acc", "g"), ("gyr", "deg/s"))
+    }
+    with pytest.raises(ValueError, match=r"files\['acc'\].*missing"):
+        io.read_multi({"files": files, "fs": 100, "gaps": "nan"}, base=tmp_path)

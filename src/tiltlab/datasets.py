@@ -275,6 +275,8 @@ def load(source: str | os.PathLike, **options) -> xr.Dataset:
     path = Path(spec)
     suffix = path.suffix.lower()
     if suffix in (".nc", ".netcdf", ".nc4", ".cdf", ".hdf5", ".h5", ".mat"):
+        if path.is_dir():
+            raise DataError(f"source {spec!r}: is a directory, not a file")
         if not path.exists():
             raise DataError(f"source {spec!r}: no such file")
         return io.read(path, **options)

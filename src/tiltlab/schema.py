@@ -32,6 +32,7 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
+from . import _validate as _v
 from . import axes as _axes
 from . import quality as _quality
 from . import units as _units
@@ -194,6 +195,13 @@ def make_recording(
         temp = _as_array(temp, "temp")
     if time is None:
         time = t0 + np.arange(n) / fs
+    time = np.asarray(time)
+    if time.dtype.kind in "mM":
+        raise RecordingError(
+            "time holds date-times or durations, not seconds: pass the seconds since "
+            "the first sample, e.g. (t - t[0]) / np.timedelta64(1, 's'), and keep the "
+            "absolute start in attrs['time_origin']"
+        )
     time = np.array(time, dtype=float)  # a copy: never alias the caller's array
     if time.shape != (n,):
         raise RecordingError(f"time must have shape ({n},), got {time.shape}")
@@ -479,7 +487,7 @@ def validate(
                 f"acc and gyr lengths differ: {n_acc} vs {n_gyr} samples"
             )
 
-    t = np.asarray(ds["time"].values, dtype=float)
+    t = _v._numeric_time(ds["time"], "validate")  # date-times refused by name
     if t.ndim != 1:
         raise RecordingError("coordinate 'time' must be one-dimensional")
     if not np.all(np.isfinite(t)):
@@ -498,6 +506,7 @@ def validate(
                 f"time is irregular: interval {i}→{i + 1} is {dt[i]:.6g} s where 1/fs = {1 / fs:.6g} s "
                 f"(deviation {jitter[i]:.2f} sample periods > max_jitter={max_jitter}); "
                 "a dropped or duplicated sample, or a wrong fs"
+                + _v.time_unit_hint(float(np.median(dt)), fs)
             )
     if ds["time"].attrs.get("units", "s") != "s":
         raise RecordingError(

@@ -60,7 +60,9 @@ def _offset(gyr: _v.Signal, offset, name: str = "offset") -> np.ndarray:
                 f"{name}='auto' needs the sampling rate fs of gyr (pass fs= or add "
                 "attrs['fs'])"
             )
-        return np.asarray(robust_gyro_offset(gyr.values, gyr.fs), float)
+        return np.asarray(
+            robust_gyro_offset(gyr.values, gyr.fs, units=gyr.units), float
+        )
     if offset is None:
         return np.zeros(3)
     return _v.vectors(offset, name, width=3, ndim=1)

@@ -43,7 +43,6 @@ from ._common import (
     _MAPPING_HELP,
     _add_check_units,
     _message,
-    _positive_int,
     _user_errors,
 )
 from .files import (
@@ -53,11 +52,10 @@ from .files import (
     _cmd_validate,
 )
 from .cohort import (
-    MAIN_FEATURES,
+    _add_cohort,
     _cmd_cohort_init,
     _cmd_cohort_run,
     _cmd_cohort_show,
-    _scheduler,
 )
 from .report import _add_report, _cmd_report
 
@@ -127,101 +125,7 @@ def _parser() -> argparse.ArgumentParser:
     )
     _add_check_units(p_conv)
 
-    p_cohort = sub.add_parser("cohort", help="cohort manifests and features")
-    csub = p_cohort.add_subparsers(dest="cohort_cmd", required=True, metavar="COMMAND")
-    p_init = csub.add_parser(
-        "init",
-        help="write a manifest from the files of a folder",
-        description="Write a cohort manifest (one row per session) from the files of "
-        "FOLDER whose relative paths match PATTERN.",
-    )
-    p_init.add_argument("folder", metavar="FOLDER")
-    p_init.add_argument(
-        "--pattern",
-        required=True,
-        help='relative path with fields, e.g. "{group}/{subject}_{timepoint}.nc"',
-    )
-    p_init.add_argument("--reader", default="netcdf", help="reader (default netcdf)")
-    p_init.add_argument(
-        "--group", help="group of every session when the pattern has no {group}"
-    )
-    p_init.add_argument(
-        "--out",
-        default="manifest.csv",
-        help="manifest to write (default manifest.csv); file paths in it are "
-        "relative to its folder",
-    )
-    p_init.add_argument(
-        "--reader-options",
-        metavar="JSON|FILE.json",
-        help="reader options for every session, as JSON text or a JSON file; for "
-        "--reader csv, the column/unit mapping (see 'tiltlab info --help')",
-    )
-    p_init.add_argument(
-        "--force", action="store_true", help="replace an existing manifest"
-    )
-
-    p_run = csub.add_parser(
-        "run",
-        help="compute the features of every session of a manifest",
-        description="Compute per-session features for a manifest and write them: "
-        "the NetCDF feature file --out (FEATURES.nc) and, beside it, the same table "
-        "for R, Excel and pandas as FEATURES.csv (UTF-8, one row per session; units "
-        "and long names in FEATURES.columns.csv) and FEATURES.parquet (units in its "
-        "field metadata). Exit status 0 if every session succeeded, 1 if any failed "
-        "(listed on stderr; the failed sessions are rows with their error), 2 if the "
-        "manifest or config is rejected.",
-    )
-    p_run.add_argument("manifest", metavar="MANIFEST")
-    p_run.add_argument(
-        "--out",
-        required=True,
-        metavar="FEATURES.nc",
-        help="feature file to write (.nc); FEATURES.csv, FEATURES.columns.csv and "
-        "FEATURES.parquet are written beside it",
-    )
-    p_run.add_argument(
-        "--workers",
-        type=_positive_int("--workers"),
-        help="worker processes (default: automatic)",
-    )
-    p_run.add_argument(
-        "--scheduler",
-        type=_scheduler,
-        metavar="ADDRESS|dask|processes",
-        help="'processes' (local pool), 'dask' (local dask.distributed cluster) or the "
-        "address of a running dask scheduler (tcp://host:8786); default serial",
-    )
-    p_run.add_argument("--config", metavar="CONFIG.json", help="feature configuration")
-    p_run.add_argument("--cache-dir", metavar="DIR", help="per-session feature cache")
-    p_run.add_argument("--no-progress", action="store_true", help="no progress bar")
-    _add_check_units(
-        p_run,
-        ' for every session (in a manifest row: reader_options {"check_units": false})',
-    )
-
-    p_show = csub.add_parser(
-        "show",
-        help="print a feature file as a table, with its config",
-        description="Print a feature file (FEATURES.nc, from 'cohort run') as a table, "
-        "with its summary and config; --export also writes it as CSV or Parquet.",
-    )
-    p_show.add_argument("features", metavar="FEATURES.nc")
-    p_show.add_argument(
-        "--export",
-        metavar="TABLE.csv|TABLE.parquet",
-        help="also write the whole feature table, one row per session, as CSV "
-        "(UTF-8; units and long names in TABLE.columns.csv) or Parquet (units in its "
-        "field metadata), for R, Excel and pandas",
-    )
-    p_show.add_argument(
-        "--max-features",
-        type=_positive_int("--max-features"),
-        default=len(MAIN_FEATURES),
-        help=f"features shown as columns (default {len(MAIN_FEATURES)}: the main ones)",
-    )
-    p_show.add_argument("--all", action="store_true", help="every feature")
-
+    _add_cohort(sub)
     _add_report(sub)
     return parser
 

@@ -216,7 +216,10 @@ def _corrected(rec: xr.Dataset, config: FeatureConfig, calibration, notes=None):
     off = np.zeros(3)
     if config.gyr_offset == "auto" and "gyr" in rec:
         try:
-            raw = np.asarray(_calibration.robust_gyro_offset(rec), float)
+            # sustained rotation is never removed as an offset: the reason is kept
+            raw = np.asarray(
+                _calibration.robust_gyro_offset(rec, on_rotation="raise"), float
+            )
         except _calibration.CalibrationError as exc:
             if notes is not None:
                 notes.append(f"gyroscope offset not removed: {exc}")

@@ -296,7 +296,8 @@ def _assemble(
         "feature_config": config.to_json(),
         "config_hash": config.hash(),
         "tiltlab_version": __version__,
-        "manifest": str(manifest.path) if manifest.path else "",
+        # the manifest's name only: the table stays valid when the study folder moves
+        "manifest": manifest.path.name if manifest.path else "",
         "n_sessions": n,
         "n_ok": n - n_failed,
         "n_failed": n_failed,

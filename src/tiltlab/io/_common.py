@@ -40,6 +40,12 @@ def _integrity_error(message, path, variable):
     return IntegrityError(message, path=path, variable=variable)
 
 
+def no_file(path) -> str:
+    """Why ``path`` cannot be read as a file: it is a folder, or nothing is there."""
+    p = Path(path)
+    return f"{p}: is a directory, not a file" if p.is_dir() else f"{p}: no such file"
+
+
 def _missing_columns_message(
     path: Path,
     df: pd.DataFrame,
@@ -96,7 +102,7 @@ def _read_table(
 ) -> pd.DataFrame:
     path = Path(path)
     if not path.is_file():
-        raise ReadError(f"{path}: no such file")
+        raise ReadError(no_file(path))
     if final_newline:
         # files written line by line end with a newline; a missing one means the copy was cut short
         with open(path, "rb") as f:

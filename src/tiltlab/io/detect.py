@@ -17,7 +17,7 @@ from typing import Any
 
 import xarray as xr
 
-from ._common import PathLike, ReadError
+from ._common import PathLike, ReadError, no_file
 from .broad import _BROAD_VARS, read_broad
 from .csv import read_csv
 from .mat import describe_mat, list_variables, mat_version
@@ -135,7 +135,7 @@ def detect(path: PathLike) -> str:
     """
     path = Path(path)
     if not path.is_file():
-        raise ReadError(f"{path}: no such file")
+        raise ReadError(no_file(path))
     version = mat_version(path)
     if version is not None:
         names = {v[0] for v in list_variables(path)}
@@ -258,7 +258,7 @@ def read(
 
     path = Path(source)
     if not path.is_file():
-        raise ReadError(f"{path}: no such file")
+        raise ReadError(no_file(path))
     check_units = bool(options.get("check_units", True))
     version = mat_version(path)
     kind = netcdf_format(path) if version is None else None

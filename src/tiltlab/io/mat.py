@@ -13,7 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ._common import PathLike, ReadError
+from ._common import PathLike, ReadError, no_file
 
 #: MATLAB classes that hold numbers (``logical`` included: it reads as 0/1).
 _NUMERIC_CLASSES = frozenset(
@@ -94,7 +94,7 @@ def list_variables(path: PathLike) -> list[tuple[str, tuple[int, ...], str]]:
     """
     path = Path(path)
     if not path.is_file():
-        raise ReadError(f"{path}: no such file")
+        raise ReadError(no_file(path))
     version = mat_version(path)
     if version == "7.3":
         import h5py

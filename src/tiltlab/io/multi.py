@@ -397,6 +397,20 @@ def read_multi(
     get: dict[str, np.ndarray] = {}
     for var, r in read.items():
         _clock.warn_if_downsampled(fs, r["info"]["rate_hz"], f"{where}files[{var!r}]")
+        if r["gaps"].size:  # refuse a grid that would be mostly NaN (a corrupt clock)
+            t, gi = r["time"], r["gaps"]
+            inside = np.searchsorted(grid, t[gi + 1], side="left") - np.searchsorted(
+                grid, t[gi], side="right"
+            )
+            _clock.check_missing_fraction(
+                t,
+                grid.size,
+                int(inside.sum()),
+                fs,
+                "time",
+                f"{where}files[{var!r}]: ",
+                gi,
+            )
         get[var] = _clock.interpolate(
             r["time"], r["values"], grid, r["gaps"], quaternion=var == "q_ref"
         )

@@ -26,7 +26,7 @@ import numpy as np
 import xarray as xr
 
 from .. import schema
-from ._common import IntegrityError, PathLike, ReadError
+from ._common import IntegrityError, PathLike, ReadError, no_file
 
 
 _ATTRS_KEY = "_tiltlab_attrs_json"
@@ -86,7 +86,7 @@ def open_netcdf(path: PathLike) -> xr.Dataset:
     """
     path = Path(path)
     if not path.is_file():
-        raise ReadError(f"{path}: no such file")
+        raise ReadError(no_file(path))
     kind = netcdf_format(path)
     if kind is None:
         raise ReadError(
@@ -199,7 +199,7 @@ def netcdf_checksums(path: PathLike) -> dict | None:
 
     path = Path(path)
     if not path.is_file():
-        raise ReadError(f"{path}: no such file")
+        raise ReadError(no_file(path))
     try:
         with h5py.File(path, "r") as f:
             raw = f.attrs.get(CHECKSUM_ATTR)
@@ -388,7 +388,7 @@ def load_netcdf(
     """
     path = Path(path)
     if not path.is_file():
-        raise ReadError(f"{path}: no such file")
+        raise ReadError(no_file(path))
     kind = netcdf_format(path)
     if kind is not None and kind != "NetCDF-4":
         raise NotRecordingError(path, _foreign(path))

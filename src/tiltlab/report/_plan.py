@@ -293,7 +293,8 @@ def _classify(source: str | os.PathLike, what: str = "source") -> _Source:
             f"'tiltlab cohort init {given} --pattern ...' writes a manifest"
         )
     if not path.is_file():
-        raise ReportError(f"{given}: no such file")
+        what = "is a directory, not a file" if path.is_dir() else "no such file"
+        raise ReportError(f"{given}: {what}")
     suffix = path.suffix.lower()
     if suffix in _MANIFEST_SUFFIXES or suffix == ".txt":
         from ..cohort import read_manifest

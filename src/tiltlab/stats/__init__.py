@@ -71,6 +71,7 @@ from .tables import (
     THRESHOLDS,
     against_baseline,
     between_groups,
+    check_cells,
     format_table,
     long_table,
 )
@@ -118,5 +119,6 @@ __all__ = [
     "long_table",
     "between_groups",
     "against_baseline",
+    "check_cells",
     "format_table",
 ]

@@ -18,7 +18,7 @@ import pandas as pd
 import xarray as xr
 
 from .nonparametric import ALTERNATIVES
-from .tables import _timepoint_key
+from .tables import _timepoint_key, check_cells
 
 __all__ = ["StudyDesign", "design_tables", "session_table", "study_design"]
 
@@ -243,7 +243,9 @@ def study_design(
     ValueError
         A group, control or time point not in the table (the message lists those that
         are: a typo never becomes a group of its own), an unknown direction, a family
-        naming a group not analysed, or fewer than two groups.
+        naming a group not analysed, fewer than two groups, or two sessions of one
+        subject at one time point (pseudo-replication, :func:`check_cells`; failed
+        sessions count), naming them.
 
     Examples
     --------
@@ -256,6 +258,7 @@ def study_design(
     (True, {'vs. sham': [('lesion', 'sham')]})
     """
     table = session_table(features)
+    check_cells(table, "the cohort table")
     failed = dict(table.loc[table["status"] != "ok", "error"])
     ok = table[table["status"] == "ok"]
     if ok.empty:

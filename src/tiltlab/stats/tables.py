@@ -3,16 +3,26 @@ out like Fayat et al.'s Tables A1–A8.
 
 Input is the cohort table of :func:`tiltlab.cohort.run_cohort` — an
 :class:`xarray.Dataset` with a ``session`` dimension, coordinates ``subject``,
-``group``, ``timepoint`` and one variable per feature (sessions whose ``status`` is
-not ``"ok"`` are skipped) — or a :class:`pandas.DataFrame` with those columns.
-Missing feature values are dropped per cell and counted in ``n_missing``.
+``group``, ``timepoint`` and one variable per feature — or a :class:`pandas.DataFrame`
+with those columns. Sessions whose ``status`` is not ``"ok"`` are left out of the tests
+and counted in ``n_failed``; missing feature values of the other sessions are dropped
+per cell and counted in ``n_missing``. Each animal is one experimental unit: a table
+with two sessions of one subject at one time point is refused (pseudo-replication),
+naming them.
 
 Tidy columns (one row per comparison × time point)
 -------------------------------------------------
-``feature, comparison, group1, group2, timepoint, test, n1, n2, n_missing, statistic,
-alternative, method, p, family_size, p_paper, p_bonferroni, p_holm, p_bh, rbc,
-rbc_low, rbc_high, ps, ps_low, ps_high, hl, hl_low, hl_high, hl_achieved, conf_level,
-note``
+``feature, comparison, group1, group2, timepoint, test, n1, n2, n_missing, n_failed,
+statistic, alternative, method, p, family_size, p_paper, p_bonferroni, p_holm, p_bh,
+rbc, rbc_low, rbc_high, ps, ps_low, ps_high, hl, hl_low, hl_high, hl_achieved,
+conf_level, note``
+
+* ``n_missing`` counts the sessions of the cell that ran but have no value of the
+  feature (against baseline: the subjects of the group without both values, for
+  another reason than a failed session); ``n_failed`` the sessions of the cell whose
+  ``status`` is not ``"ok"`` (against baseline: those at the time point and at the
+  baseline). ``n1 + n2 + n_missing + n_failed`` is every session of a between-group
+  cell.
 
 * ``alternative`` states the direction: ``"greater"`` means ``group1`` (or the time
   point, against baseline) tends to be larger.
@@ -55,6 +65,7 @@ from .nonparametric import _alternative, mann_whitney, wilcoxon_signed_rank
 
 __all__ = [
     "long_table",
+    "check_cells",
     "between_groups",
     "against_baseline",
     "format_table",
@@ -70,21 +81,9 @@ _DURATION = re.compile(r"^\s*([-+]?\d+(?:\.\d+)?)\s*(min|h|d|w)\s*$", re.IGNOREC
 _UNIT_HOURS = {"min": 1 / 60, "h": 1.0, "d": 24.0, "w": 168.0}
 
 
-def long_table(features, feature: str) -> pd.DataFrame:
-    """One row per usable session: ``subject``, ``group``, ``timepoint``, ``value``.
-
-    Parameters
-    ----------
-    features : xarray.Dataset or pandas.DataFrame
-        The cohort table (see the module docstring).
-    feature : str
-        The feature variable / column.
-
-    Returns
-    -------
-    pandas.DataFrame
-        Sessions with ``status == "ok"`` (when a status exists); ``value`` may be NaN.
-    """
+def _frame(features, feature: str) -> pd.DataFrame:
+    """Every session: ``session`` (None when the table has no ids), ``subject``,
+    ``group``, ``timepoint``, ``value`` and ``status`` (``"ok"`` when absent)."""
     need = ("subject", "group", "timepoint")
     if isinstance(features, xr.Dataset):
         if "session" not in features.dims:
@@ -101,25 +100,111 @@ def long_table(features, feature: str) -> pd.DataFrame:
             raise ValueError(f"features lacks coordinate(s) {missing}")
         cols = {c: features[c].values for c in need}
         cols["value"] = features[feature].values
-        if "status" in features.variables:
-            cols["status"] = features["status"].values
+        cols["status"] = (
+            features["status"].values.astype(str)
+            if "status" in features.variables
+            else "ok"
+        )
+        cols["session"] = (
+            features["session"].values.astype(str)
+            if "session" in features.variables
+            else None
+        )
         df = pd.DataFrame(cols)
     elif isinstance(features, pd.DataFrame):
         missing = [c for c in (*need, feature) if c not in features.columns]
         if missing:
             raise ValueError(f"features lacks column(s) {missing}")
-        keep = list(need) + (["status"] if "status" in features.columns else [])
-        df = features[keep].copy()
+        df = features[list(need)].copy()
         df["value"] = features[feature].to_numpy()
+        df["status"] = (
+            features["status"].astype(str).to_numpy()
+            if "status" in features.columns
+            else "ok"
+        )
+        df["session"] = (
+            features["session"].astype(str).to_numpy()
+            if "session" in features.columns
+            else None
+        )
     else:
         raise ValueError(
             f"features must be an xarray.Dataset or a pandas.DataFrame, got "
             f"{type(features).__name__}"
         )
-    if "status" in df.columns:
-        df = df[df["status"].astype(str) == "ok"].drop(columns="status")
     df["value"] = pd.to_numeric(df["value"], errors="coerce").astype(float)
     return df.reset_index(drop=True)
+
+
+def check_cells(table: pd.DataFrame, what: str = "features") -> None:
+    """Refuse a cohort table with two sessions of one subject at one time point.
+
+    Each animal is one experimental unit: two sessions of it in one cell would count
+    it twice (pseudo-replication) in a between-group test, and cannot be paired with
+    its baseline. Every session counts, failed ones included.
+
+    Parameters
+    ----------
+    table : pandas.DataFrame
+        With ``subject`` and ``timepoint`` columns, and ``session`` ids as a column or
+        as the index (named ``session``) when available.
+    what : str
+        The table's name in the message.
+
+    Raises
+    ------
+    ValueError
+        Naming each duplicated (subject, time point) and its sessions (or rows).
+    """
+    df = table.reset_index() if table.index.name == "session" else table
+    dup = df.duplicated(["subject", "timepoint"], keep=False)
+    if not dup.any():
+        return
+    cells = []
+    for (subject, tp), rows in df[dup].groupby(
+        ["subject", "timepoint"], sort=False, dropna=False
+    ):
+        if "session" in rows.columns and rows["session"].notna().all():
+            which = "sessions " + ", ".join(map(repr, rows["session"].astype(str)))
+        else:
+            which = "rows " + ", ".join(str(i) for i in rows.index)
+        cells.append(f"subject {subject!r} at {tp!r} ({which})")
+    shown = "; ".join(cells[:5]) + (
+        f"; and {len(cells) - 5} more" if len(cells) > 5 else ""
+    )
+    raise ValueError(
+        f"{what} has more than one session of a subject at a time point: {shown}. "
+        "Each animal is one unit: counting it twice is pseudo-replication. Keep one "
+        "session per subject and time point (drop one, or average them into one row) "
+        "before testing"
+    )
+
+
+def long_table(features, feature: str, *, include_failed: bool = False) -> pd.DataFrame:
+    """One row per usable session: ``subject``, ``group``, ``timepoint``, ``value``.
+
+    Parameters
+    ----------
+    features : xarray.Dataset or pandas.DataFrame
+        The cohort table (see the module docstring).
+    feature : str
+        The feature variable / column.
+    include_failed : bool
+        Also return the sessions whose ``status`` is not ``"ok"`` (``value`` NaN
+        there), with a ``status`` column, e.g. to count them.
+
+    Returns
+    -------
+    pandas.DataFrame
+        Sessions with ``status == "ok"`` (when a status exists), or every session with
+        ``include_failed``; ``value`` may be NaN.
+    """
+    df = _frame(features, feature)
+    keep = ["subject", "group", "timepoint", "value"]
+    if include_failed:
+        df.loc[df["status"] != "ok", "value"] = np.nan
+        return df[keep + ["status"]].reset_index(drop=True)
+    return df.loc[df["status"] == "ok", keep].reset_index(drop=True)
 
 
 def _timepoint_key(label) -> float:
@@ -170,7 +255,7 @@ def _effects_row(x, y, conf_level, paired, zero_method="wilcox") -> dict:
 
 
 _COLUMNS = (
-    "feature comparison group1 group2 timepoint test n1 n2 n_missing statistic "
+    "feature comparison group1 group2 timepoint test n1 n2 n_missing n_failed statistic "
     "alternative method p rbc rbc_low rbc_high ps ps_low ps_high hl hl_low hl_high "
     "hl_achieved conf_level note"
 ).split()
@@ -231,13 +316,23 @@ def between_groups(
     Returns
     -------
     pandas.DataFrame
-        The tidy table, one row per comparison × time point.
+        The tidy table, one row per comparison × time point; ``n_failed`` counts the
+        failed sessions of the two groups at that time point, left out.
+
+    Raises
+    ------
+    ValueError
+        Two sessions of one subject at one time point (:func:`check_cells`), a group
+        absent from the data, a comparison without a direction.
     """
     conf_level = _validate.fraction(
         conf_level, "conf_level", open_low=True, open_high=True
     )
-    df = long_table(features, feature)
-    groups = set(df["group"])
+    full = _frame(features, feature)
+    check_cells(full)
+    ok = full["status"] == "ok"
+    df, failed = full[ok], full[~ok]
+    groups = set(full["group"])
     specs = []
     for comp in comparisons:
         if not isinstance(comp, (tuple, list)) or len(comp) not in (2, 3):
@@ -262,7 +357,7 @@ def between_groups(
         specs.append((g1, g2, alt))
     if not specs:
         raise ValueError("comparisons is empty")
-    tps = _ordered_timepoints(df, baseline, timepoints)
+    tps = _ordered_timepoints(full, baseline, timepoints)
     rows = []
     for g1, g2, alt in specs:
         for t in tps:
@@ -270,6 +365,9 @@ def between_groups(
             x = cell.loc[cell["group"] == g1, "value"].to_numpy()
             y = cell.loc[cell["group"] == g2, "value"].to_numpy()
             miss = int(np.isnan(x).sum() + np.isnan(y).sum())
+            n_failed = int(
+                ((failed["timepoint"] == t) & failed["group"].isin([g1, g2])).sum()
+            )
             x, y = x[~np.isnan(x)], y[~np.isnan(y)]
             row = {
                 "feature": feature,
@@ -281,6 +379,7 @@ def between_groups(
                 "n1": x.size,
                 "n2": y.size,
                 "n_missing": miss,
+                "n_failed": n_failed,
                 "alternative": alt,
                 "conf_level": conf_level,
                 "note": "",
@@ -346,13 +445,24 @@ def against_baseline(
     -------
     pandas.DataFrame
         The tidy table; ``comparison`` reads ``"<group> vs. <group> baseline"`` as in
-        the paper; ``n1 = n2`` = number of pairs.
+        the paper; ``n1 = n2`` = number of pairs; ``n_failed`` counts the group's
+        failed sessions at the time point and at the baseline, ``n_missing`` the
+        subjects of the group without both values for another reason.
+
+    Raises
+    ------
+    ValueError
+        Two sessions of one subject at one time point (:func:`check_cells`), a group
+        or the baseline absent from the data, a group without a direction.
     """
     conf_level = _validate.fraction(
         conf_level, "conf_level", open_low=True, open_high=True
     )
-    df = long_table(features, feature)
-    present = list(dict.fromkeys(df["group"]))
+    full = _frame(features, feature)
+    check_cells(full)
+    ok = full["status"] == "ok"
+    df = full[ok]
+    present = list(dict.fromkeys(full["group"]))
     groups = present if groups is None else list(groups)
     for g in groups:
         if g not in present:
@@ -368,20 +478,19 @@ def against_baseline(
         alts = dict.fromkeys(groups, alternative)
     for a in alts.values():
         _alternative(a)
-    if baseline not in set(df["timepoint"]):
+    if baseline not in set(full["timepoint"]):
         raise ValueError(f"baseline {baseline!r} is not a time point of the data")
-    tps = _ordered_timepoints(df, baseline, timepoints)
+    tps = _ordered_timepoints(full, baseline, timepoints)
     rows = []
     for g in groups:
-        sub = df[df["group"] == g]
-        dup = sub.duplicated(["subject", "timepoint"])
-        if dup.any():
-            first = sub[dup].iloc[0]
-            raise ValueError(
-                f"features has two sessions of subject {first['subject']!r} at "
-                f"{first['timepoint']!r}; cannot pair with the baseline"
-            )
-        wide = sub.pivot(index="subject", columns="timepoint", values="value")
+        in_group = full[full["group"] == g]
+        subjects = list(dict.fromkeys(in_group["subject"]))
+        wide = (
+            df[df["group"] == g]
+            .pivot(index="subject", columns="timepoint", values="value")
+            .reindex(index=subjects)
+        )
+        lost = in_group[in_group["status"] != "ok"]
         for t in tps:
             row = {
                 "feature": feature,
@@ -394,14 +503,24 @@ def against_baseline(
                 "conf_level": conf_level,
                 "note": "",
             }
+            at = lost[lost["timepoint"].isin([t, baseline])]
+            row["n_failed"] = len(at)
+            broken = set(at["subject"])  # pairs lost to a failed session
             if t not in wide.columns or baseline not in wide.columns:
-                row.update(n1=0, n2=0, n_missing=len(wide), note="not tested: no data")
+                row.update(
+                    n1=0,
+                    n2=0,
+                    n_missing=len([s for s in subjects if s not in broken]),
+                    note="not tested: no data",
+                )
                 rows.append(row)
                 continue
             pair = wide[[t, baseline]]
-            ok = pair.notna().all(axis=1)
-            x, y = pair.loc[ok, t].to_numpy(), pair.loc[ok, baseline].to_numpy()
-            row.update(n1=x.size, n2=x.size, n_missing=int((~ok).sum()))
+            complete = pair.notna().all(axis=1)
+            x = pair.loc[complete, t].to_numpy()
+            y = pair.loc[complete, baseline].to_numpy()
+            incomplete = [s for s in pair.index[~complete] if s not in broken]
+            row.update(n1=x.size, n2=x.size, n_missing=len(incomplete))
             try:
                 res = wilcoxon_signed_rank(
                     x,
