@@ -548,3 +548,38 @@ def test_cli_workers_help_says_what_runs(capsys):
 
     assert backend(None, None).name == "serial"
     assert backend(None, 1).name == "serial"
+
+
+def test_a_group_label_one_letter_off_is_warned(tmp_path):
+    """Undeclared groups 'translation' and 'translaton' (a typo) are read with a
+    warning naming both and how to make it an error; short labels (d1, d7) are not."""
+    import warnings as _w
+
+    import pandas as pd
+
+    from tiltlab import cohort
+
+    rows = []
+    for k, g in enumerate(["translation"] * 3 + ["translaton"] + ["rotation"] * 3):
+        f = tmp_path / f"s{k}.nc"
+        f.write_bytes(bytes([k]) * (k + 1))  # distinct content
+        rows.append(
+            {
+                "session": f"s{k}",
+                "subject": f"a{k}",
+                "group": g,
+                "timepoint": "d1",
+                "file": f.name,
+                "reader": "netcdf",
+            }
+        )
+    pd.DataFrame(rows).to_csv(tmp_path / "m.csv", index=False)
+    with pytest.warns(
+        cohort.ManifestWarning,
+        match=r"'translation' \(3 sessions\).*'translaton' \(1 sessions\).*groups=",
+    ):
+        cohort.read_manifest(tmp_path / "m.csv")
+    with _w.catch_warnings():
+        _w.simplefilter("error", cohort.ManifestWarning)
+        with pytest.raises(cohort.ManifestError, match="translaton"):
+            cohort.read_manifest(tmp_path / "m.csv", groups=["translation", "rotation"])

@@ -75,6 +75,7 @@ __all__ = [
     "READERS",
     "PATTERN_HELP",
     "ManifestError",
+    "ManifestWarning",
     "Manifest",
     "read_manifest",
     "init_manifest",
@@ -122,6 +123,11 @@ READERS: dict[str, Callable[..., xr.Dataset]] = {
 }
 #: calibration file suffix → reader
 _CALIBRATION_READERS = {".nc": "netcdf", ".netcdf": "netcdf", ".csv": "fayat_tumble"}
+
+
+class ManifestWarning(UserWarning):
+    """A manifest that is valid but looks wrong (e.g. two group labels one letter
+    apart)."""
 
 
 class ManifestError(ValueError):
@@ -541,7 +547,35 @@ def read_manifest(
         raise ManifestError(f"{path.name}: not a readable CSV table ({e})") from None
     root = path.parent.resolve()
     table = _check_table(df, root, path.name, groups, timepoints=timepoints)
+    if groups is None:
+        _warn_near_duplicates(table["group"], "groups", "groups=", path.name)
+    if timepoints is None:
+        _warn_near_duplicates(
+            table["timepoint"], "time points", "timepoints=", path.name
+        )
     return Manifest(table=table, root=root, path=path.resolve())
+
+
+def _warn_near_duplicates(column, what: str, keyword: str, where: str) -> None:
+    """Warn when two labels of a column differ by a letter or two (``translaton`` next
+    to ``translation``): likely a typo that would make a group or time point of its
+    own. Only a warning: labels such as ``d1``/``d7`` are close on purpose; declaring
+    the labels (``keyword``) makes an undeclared one an error."""
+    counts = column.astype(str).value_counts()
+    labels = list(counts.index)
+    for i, a in enumerate(labels):
+        for b in labels[i + 1 :]:
+            if min(len(a), len(b)) < 5:  # short labels (d1, d7, A, B) differ by design
+                continue
+            if difflib.SequenceMatcher(None, a.lower(), b.lower()).ratio() >= 0.85:
+                warnings.warn(
+                    f"{where}: {what} {a!r} ({counts[a]} sessions) and {b!r} "
+                    f"({counts[b]} sessions) differ by a letter or two: a typo? "
+                    f"Declare the study's {what} ({keyword}, or --{keyword[:-1]} on "
+                    "the command line) to make an undeclared label an error",
+                    ManifestWarning,
+                    stacklevel=3,
+                )
 
 
 # ------------------------------------------------------------------ loading
