@@ -493,3 +493,18 @@ def test_multi_file_regridding_to_mostly_nan_is_refused(tmp_path):
     }
     with pytest.raises(ValueError, match=r"files\['acc'\].*missing"):
         io.read_multi({"files": files, "fs": 100, "gaps": "nan"}, base=tmp_path)
+
+
+@pytest.mark.parametrize(
+    "cell, message", [("NaN", "missing value 'NaN'"), ("", "empty field")]
+)
+def test_fixed_column_readers_name_missing_text(tmp_path, cell, message):
+    """The text NaN in a published data set's CSV is named as a missing value, not as an
+    empty field of a truncated file."""
+    from tiltlab import io
+
+    lines = ["counter,ax,ay,az,gx,gy,gz"] + [f"{3 * i},0,0,1,0,0,0" for i in range(5)]
+    lines[3] = f"6,{cell},0,1,0,0,0"
+    (tmp_path / "a.csv").write_text("\n".join(lines) + "\n")
+    with pytest.raises(io.ReadError, match=f"{message} in column 'ax', data row 2"):
+        io.read_fayat_imu(tmp_path / "a.csv")

@@ -128,8 +128,20 @@ def _read_table(
         )
     if numeric.isna().to_numpy().any():
         row, col = np.argwhere(numeric.isna().to_numpy())[0]
+        n_missing = int(numeric.isna().to_numpy().sum())
+        try:  # the text as written: an empty field, or a word such as NaN or NA
+            raw = pd.read_csv(
+                path, **{**kwargs, "dtype": str, "keep_default_na": False}
+            )
+            text = str(raw[required[col]].iat[row]).strip()
+        except (ValueError, KeyError, IndexError, OSError):
+            text = ""
+        what = f"missing value {text!r}" if text else "empty field"
+        hint = " (truncated file?)" if not text else ""
         raise ReadError(
-            f"{path}: empty field in column {required[col]!r}, data row {row} (truncated file?)"
+            f"{path}: {what} in column {required[col]!r}, data row {row}"
+            f" ({n_missing} missing value(s) in all){hint}; the readers of published "
+            "data sets need every sample"
         )
     if len(numeric) < 2:
         raise ReadError(f"{path}: fewer than two samples")
