@@ -35,7 +35,8 @@ from .circling import *  # noqa: F401,F403
 from .circling import __all__ as _circling
 from .immobility import *  # noqa: F401,F403
 from .immobility import __all__ as _immobility
+from .realism import realism_table
 from .speed import *  # noqa: F401,F403
 from .speed import __all__ as _speed
 
-__all__ = [*_speed, *_immobility, *_circling, *_activity]
+__all__ = [*_speed, *_immobility, *_circling, *_activity, "realism_table"]

@@ -35,12 +35,11 @@ from .fayat import read_fayat_imu, read_fayat_tumble
 from .mapping import mapping_template
 from .mat import read_matrix
 from .multi import read_multi
+from .ncfile import netcdf_format, open_netcdf
 from .netcdf import (
     NotRecordingError,
     load_netcdf,
     netcdf_checksums,
-    netcdf_format,
-    open_netcdf,
     save_netcdf,
 )
 from .tagtools import read_tagtools, write_tagtools

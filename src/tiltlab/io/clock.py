@@ -25,6 +25,10 @@ from .. import _validate
 from .. import quality as _quality
 from .. import schema
 
+#: Sampling rates (Hz) accepted unless told otherwise: a value outside this range almost
+#: always means a time column in the wrong unit.
+FS_RANGE: tuple[float, float] = (1.0, 20_000.0)
+
 #: Units accepted for a time column, as factors to seconds.
 TIME_UNITS: dict[str, float] = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "ns": 1e-9}
 _TIME_ALIASES = {
@@ -102,8 +106,6 @@ def unit_hint(
 ) -> str:
     """Which time unit (other than the one in use, factor ``scale`` to seconds) would
     make ``raw_step`` (in the column's numbers) a plausible sampling interval."""
-    from .mapping import FS_RANGE
-
     lo, hi = fs_range or FS_RANGE
     for unit, factor in TIME_UNITS.items():
         if scale is not None and np.isclose(factor, scale):

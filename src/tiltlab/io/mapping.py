@@ -18,6 +18,7 @@ from .. import quality as _quality
 from .. import units as _units
 from ._common import PathLike, ReadError
 from .clock import (
+    FS_RANGE,
     CLOCK_POLICIES,
     DATETIME,
     GAP_POLICIES,
@@ -26,9 +27,6 @@ from .clock import (
     time_factor,
 )
 
-#: Sampling rates (Hz) accepted unless told otherwise: a value outside this range almost
-#: always means a time column in the wrong unit.
-FS_RANGE: tuple[float, float] = (1.0, 20_000.0)
 
 #: Number of columns each Recording variable takes.
 WIDTH = {"acc": 3, "gyr": 3, "mag": 3, "temp": 1, "q_ref": 4}

@@ -27,94 +27,12 @@ import xarray as xr
 
 from .. import schema
 from ._common import IntegrityError, PathLike, ReadError, no_file
+from .tagtools import looks_like_tagtools
+from .ncfile import _ATTRS_KEY, netcdf_format
 
 
-_ATTRS_KEY = "_tiltlab_attrs_json"
 #: File attribute holding the checksums written by :func:`save_netcdf` (JSON).
 CHECKSUM_ATTR = "_tiltlab_sha256"
-
-_MAGIC = {
-    b"CDF\x01": "NetCDF-3 classic",
-    b"CDF\x02": "NetCDF-3 64-bit offset",
-    b"CDF\x05": "NetCDF-3 64-bit data (CDF-5)",
-}
-
-
-def netcdf_format(path: PathLike) -> str | None:
-    """The NetCDF flavour of a file from its first bytes, or None if it is not NetCDF.
-
-    Parameters
-    ----------
-    path
-        File to inspect.
-
-    Returns
-    -------
-    str or None
-        ``"NetCDF-4"`` (an HDF5 file), ``"NetCDF-3 classic"``, ``"NetCDF-3 64-bit
-        offset"``, ``"NetCDF-3 64-bit data (CDF-5)"``, or None.
-    """
-    try:
-        with open(path, "rb") as f:
-            head = f.read(8)
-    except OSError:
-        return None
-    if head == b"\x89HDF\r\n\x1a\n":
-        return "NetCDF-4"
-    return _MAGIC.get(head[:4])
-
-
-def open_netcdf(path: PathLike) -> xr.Dataset:
-    """Open any NetCDF file (NetCDF-4 or NetCDF-3) into memory, values as stored.
-
-    Times are not decoded; the engine is chosen from the file's first bytes.
-
-    Parameters
-    ----------
-    path
-        A NetCDF file.
-
-    Returns
-    -------
-    xarray.Dataset
-        The file's content, loaded.
-
-    Raises
-    ------
-    ReadError
-        If the file is missing, not NetCDF, or damaged.
-    """
-    path = Path(path)
-    if not path.is_file():
-        raise ReadError(no_file(path))
-    kind = netcdf_format(path)
-    if kind is None:
-        raise ReadError(
-            f"{path}: not a NetCDF file (neither NetCDF-4/HDF5 nor NetCDF-3)"
-        )
-    if "CDF-5" in kind:
-        raise ReadError(
-            f"{path}: {kind} file, which the installed NetCDF engines cannot read; "
-            "rewrite it as NetCDF-4 (nccopy -k nc4 IN OUT)"
-        )
-    engine = "h5netcdf" if kind == "NetCDF-4" else "scipy"
-    try:
-        with xr.open_dataset(
-            path, engine=engine, decode_times=False, mask_and_scale=False
-        ) as f:
-            return f.load()
-    except Exception as exc:  # noqa: BLE001 - engines raise many types on damage
-        raise ReadError(
-            f"{path}: cannot read {kind} file ({type(exc).__name__}: {exc}); "
-            "truncated or corrupt?"
-        ) from None
-
-
-def is_recording(ds: xr.Dataset) -> bool:
-    """True if an opened NetCDF file holds a tiltlab Recording (or a file tiltlab wrote)."""
-    if _ATTRS_KEY in ds.attrs:
-        return True
-    return "acc" in ds.data_vars and "time" in ds.dims and "fs" in ds.attrs
 
 
 def _json_default(o):
@@ -349,7 +267,7 @@ class NotRecordingError(ReadError):
 
 
 def _foreign(path: Path) -> str:
-    from .detect import detect  # detect imports this module
+    from .describe import detect
 
     return detect(path)
 
@@ -402,8 +320,6 @@ def load_netcdf(
     if _ATTRS_KEY not in ds.attrs and ("time" not in ds.dims or "acc" not in ds):
         # not written by tiltlab, and no Recording layout: say what it is instead of
         # failing later on a missing 'time' or 'acc'
-        from .tagtools import looks_like_tagtools
-
         if looks_like_tagtools(ds) or "session" not in ds.dims:
             raise NotRecordingError(path, _foreign(path))
     raw_sums = ds.attrs.pop(CHECKSUM_ATTR, None)

@@ -24,7 +24,7 @@ import xarray as xr
 from .. import schema
 from ..quality import QualityWarning
 from ._common import PathLike, ReadError
-from .netcdf import open_netcdf
+from .ncfile import open_netcdf
 
 #: tiltlab role of each tag-tools variable name (first match wins).
 ROLES: dict[str, tuple[str, ...]] = {
@@ -89,7 +89,7 @@ def sensor_variables(ds: xr.Dataset) -> dict[str, str]:
     Parameters
     ----------
     ds
-        The file opened with :func:`tiltlab.io.netcdf.open_netcdf`.
+        The file opened with :func:`tiltlab.io.open_netcdf`.
 
     Returns
     -------
