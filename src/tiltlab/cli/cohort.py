@@ -427,7 +427,7 @@ _READER_NAMES = (
     "auto",
 )
 
-#: The pattern grammar (:data:`tiltlab.cohort.manifest.PATTERN_HELP`) as options say it.
+#: The pattern grammar (:data:`tiltlab.cohort.initialize.PATTERN_HELP`) as options say it.
 _PATTERN_EPILOG = (
     "Patterns: a pattern is a file's path relative to FOLDER, with '/' between "
     "folders, in which {name} fields stand for parts of the path. A field matches one "

@@ -3,8 +3,11 @@ r"""Cohorts: from a lab's folder of sessions to one feature table (layer 7).
 * :mod:`~tiltlab.cohort.manifest` — the cohort manifest (one CSV row per session:
   ``session, subject, group, timepoint, file, reader, reader_options, calibration`` and
   covariates), :func:`read_manifest` (rejects a malformed manifest before any work,
-  naming the row), :func:`init_manifest` (from files matching a pattern such as
-  ``"{group}/{subject}_{timepoint}.nc"``), :func:`load_session`;
+  naming the row);
+* :mod:`~tiltlab.cohort.sessions` — :data:`READERS`, :func:`load_session` and
+  :func:`load_calibration`: a session's recording and tumble test, as a row names them;
+* :mod:`~tiltlab.cohort.initialize` — :func:`init_manifest` (from files matching a
+  pattern such as ``"{group}/{subject}_{timepoint}.nc"``);
 * :mod:`~tiltlab.cohort.config` — :class:`FeatureConfig`, every choice of the
   pipeline, frozen, validated, serialisable and hashed;
 * :mod:`~tiltlab.cohort.features` — :func:`session_features`: calibration →
@@ -38,6 +41,7 @@ References
 
 from .config import FeatureConfig
 from .features import empty_features, feature_specs, session_features, session_tilt
+from .initialize import init_manifest
 from .manifest import (
     OPTIONAL_COLUMNS,
     READERS,
@@ -45,7 +49,6 @@ from .manifest import (
     Manifest,
     ManifestError,
     ManifestWarning,
-    init_manifest,
     load_calibration,
     load_session,
     read_manifest,

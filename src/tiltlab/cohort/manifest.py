@@ -39,8 +39,11 @@ the study declares them (``groups=``, ``timepoints=``), a group or time point it
 not declare (a typo). A session file that is missing or unreadable is *not* a manifest
 error: :func:`tiltlab.cohort.run_cohort` records it as a failed session.
 
-:func:`init_manifest` writes a manifest from the files of a folder whose paths match a
-pattern (:data:`PATTERN_HELP` states its grammar) or an explicit regular expression.
+Each session's recording is read by :func:`load_session` (with the reader registry
+:data:`READERS`, in :mod:`~tiltlab.cohort.sessions`);
+:func:`~tiltlab.cohort.init_manifest` (in :mod:`~tiltlab.cohort.initialize`) writes a
+manifest from the files of a folder whose paths match a pattern or an explicit regular
+expression.
 
 References
 ----------
@@ -53,32 +56,34 @@ from __future__ import annotations
 
 import difflib
 import hashlib
-import inspect
-import json
 import os
 import re
 import warnings
-from collections.abc import Callable, Iterator, Mapping, Sequence
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import pandas as pd
-import xarray as xr
 
-from .. import io as _io
-from ..quality import UnitCheckError
+from .sessions import (
+    _CALIBRATION_READERS,
+    READERS,
+    ManifestError,
+    _options,
+    load_calibration,
+    load_session,
+    session_path,
+)
 
 __all__ = [
     "REQUIRED_COLUMNS",
     "OPTIONAL_COLUMNS",
     "READERS",
-    "PATTERN_HELP",
     "ManifestError",
     "ManifestWarning",
     "Manifest",
     "read_manifest",
-    "init_manifest",
     "load_session",
     "load_calibration",
     "session_path",
@@ -95,44 +100,9 @@ REQUIRED_COLUMNS: tuple[str, ...] = (
 OPTIONAL_COLUMNS: tuple[str, ...] = ("reader_options", "calibration")
 
 
-def _read_netcdf(
-    path,
-    *,
-    allow_nan: bool | None = None,
-    max_jitter: float = 0.35,
-    quat_atol: float = 1e-6,
-    check_units: bool = True,
-) -> xr.Dataset:
-    """A NetCDF Recording (:func:`tiltlab.io.load_netcdf`), validated with these
-    options of :func:`tiltlab.schema.validate`."""
-    kw = {"max_jitter": max_jitter, "quat_atol": quat_atol, "check_units": check_units}
-    if allow_nan is not None:
-        kw["allow_nan"] = allow_nan
-    return _io.load_netcdf(path, validate=True, **kw)
-
-
-#: reader name → function ``reader(path, **reader_options)`` returning a Recording
-READERS: dict[str, Callable[..., xr.Dataset]] = {
-    "netcdf": _read_netcdf,
-    "fayat_csv": _io.read_fayat_imu,
-    "fayat_tumble": _io.read_fayat_tumble,
-    "broad": _io.read_broad,
-    "csv": _io.read_csv,
-    "tagtools": _io.read_tagtools,
-    "auto": _io.read,
-}
-#: calibration file suffix → reader
-_CALIBRATION_READERS = {".nc": "netcdf", ".netcdf": "netcdf", ".csv": "fayat_tumble"}
-
-
 class ManifestWarning(UserWarning):
     """A manifest that is valid but looks wrong (e.g. two group labels one letter
     apart)."""
-
-
-class ManifestError(ValueError):
-    """A manifest is malformed; the message names the line (or, for
-    :func:`init_manifest`, the file) and the session."""
 
 
 @dataclass(frozen=True)
@@ -236,45 +206,6 @@ _LEADING_ZERO = re.compile(r"^[+-]?0\d")
 def _where(name: str, line: int, session: str | None = None) -> str:
     s = f"{name}, line {line}"
     return f"{s} (session {session!r})" if session else s
-
-
-def _options(text: str, reader: str, where: str) -> dict[str, Any]:
-    text = "" if text is None else str(text).strip()
-    if not text:
-        opts: Any = {}
-    else:
-        try:
-            opts = json.loads(text)
-        except json.JSONDecodeError as exc:
-            raise ManifestError(
-                f"{where}: reader_options is not valid JSON ({exc.msg} at character "
-                f"{exc.pos}): {text!r}"
-            ) from None
-    if not isinstance(opts, dict):
-        raise ManifestError(
-            f"{where}: reader_options must be a JSON object, got {type(opts).__name__}"
-        )
-    if reader == "csv":
-        missing = [k for k in ("columns", "units") if k not in opts]
-        if missing:
-            raise ManifestError(
-                f"{where}: the csv reader needs reader_options {missing} (a column and "
-                "unit mapping, and fs or time_column)"
-            )
-        if "fs" not in opts and "time_column" not in opts:
-            raise ManifestError(
-                f"{where}: the csv reader needs 'fs' or 'time_column' in "
-                "reader_options: tiltlab never assumes a sampling rate"
-            )
-    else:
-        params = inspect.signature(READERS[reader]).parameters
-        if not any(p.kind is inspect.Parameter.VAR_KEYWORD for p in params.values()):
-            unknown = [k for k in opts if k not in params or k == "path"]
-            if unknown:
-                raise ManifestError(
-                    f"{where}: reader {reader!r} does not accept option(s) {unknown}"
-                )
-    return opts
 
 
 def _maybe_numeric(col: pd.Series) -> pd.Series:
@@ -576,412 +507,3 @@ def _warn_near_duplicates(column, what: str, keyword: str, where: str) -> None:
                     ManifestWarning,
                     stacklevel=3,
                 )
-
-
-# ------------------------------------------------------------------ loading
-
-
-def session_path(file, root) -> Path:
-    """``file`` if absolute, else ``root / file``."""
-    p = Path(str(file)).expanduser()
-    return p if p.is_absolute() else Path(root) / p
-
-
-def _takes(func: Callable[..., Any], name: str) -> bool:
-    """True if ``func`` accepts the keyword ``name`` (explicitly or through ``**``)."""
-    try:
-        params = inspect.signature(func).parameters
-    except (TypeError, ValueError):
-        return False
-    if name in params:
-        return True
-    # **attrs of a reader are dataset attributes, not options: only io.read forwards
-    return func is _io.read
-
-
-def load_session(row: Mapping[str, Any], root) -> xr.Dataset:
-    """Read one session's Recording with the reader its manifest row names.
-
-    Parameters
-    ----------
-    row : mapping
-        A manifest row (a dict from :meth:`Manifest.rows` or a pandas Series) with
-        ``file``, ``reader`` and optionally ``reader_options`` (JSON text or a dict).
-    root : path-like
-        Folder of the manifest (:attr:`Manifest.root`).
-
-    Returns
-    -------
-    xarray.Dataset
-        The Recording, validated by its reader (:func:`tiltlab.schema.validate`), with
-        the manifest's ``session``, ``subject`` and ``group`` added to its attrs as
-        ``cohort_session``, ``cohort_subject`` and ``cohort_group``.
-
-    Raises
-    ------
-    tiltlab.io.ReadError
-        A missing, truncated or unreadable file.
-    tiltlab._validate.RecordingError
-        A recording that breaks the Recording contract.
-    """
-    reader = str(row["reader"])
-    if reader not in READERS:
-        raise ManifestError(f"unknown reader {reader!r}; known: {sorted(READERS)}")
-    opts = row.get("reader_options", "")
-    if not isinstance(opts, Mapping):
-        opts = _options(opts, reader, f"session {row.get('session')!r}")
-    opts = dict(opts)
-    func = READERS[reader]
-    try:
-        rec = func(session_path(row["file"], root), **opts)
-    except UnitCheckError as err:
-        # name the switch as a manifest gives it
-        raise err.for_switch("manifest") from None
-    extra = {
-        f"cohort_{k}": str(row[k]) for k in ("session", "subject", "group") if k in row
-    }
-    return rec.assign_attrs(extra) if extra else rec
-
-
-def load_calibration(row: Mapping[str, Any], root) -> xr.Dataset | None:
-    """The tumble-test Recording named in a manifest row's ``calibration``, or None.
-
-    ``.nc`` files are read with :func:`tiltlab.io.load_netcdf` (validated), ``.csv``
-    files with :func:`tiltlab.io.read_fayat_tumble`.
-    """
-    cal = str(row.get("calibration", "") or "").strip()
-    if not cal or cal == "nan":
-        return None
-    reader = _CALIBRATION_READERS.get(Path(cal).suffix.lower())
-    if reader is None:
-        raise ManifestError(f"calibration file {cal!r} must be .nc or .csv")
-    opts = row.get("reader_options", "")
-    if not isinstance(opts, Mapping):
-        try:
-            opts = json.loads(str(opts)) if str(opts or "").strip() else {}
-        except json.JSONDecodeError:
-            opts = {}
-    kw = {}
-    if isinstance(opts, Mapping) and opts.get("check_units") is False:
-        if _takes(READERS[reader], "check_units"):
-            kw["check_units"] = False
-    try:
-        return READERS[reader](session_path(cal, root), **kw)
-    except UnitCheckError as err:
-        raise err.for_switch("manifest") from None
-
-
-# ------------------------------------------------------------------ init_manifest
-
-#: The grammar of :func:`init_manifest`'s patterns, in words (also ``--help``).
-PATTERN_HELP = (
-    "A pattern is a file's path relative to FOLDER, with '/' between folders, in which "
-    "{name} fields stand for parts of the path. A field matches one or more "
-    "characters other than '/'; fields are read from left to right, each taking as "
-    "much as it can, so where a separator (such as '_') stands between two fields "
-    "the path is split at the separator's LAST occurrence: with "
-    "'{group}/{subject}_{timepoint}.nc', 'A/rat_01_d0.nc' is subject 'rat_01' at "
-    "time point 'd0'. Only the last field of a path segment must therefore be free "
-    "of the separator that comes before it (time points such as d0, 7d, baseline). "
-    "Two fields must be separated by some text ('{subject}{timepoint}' is refused), "
-    "and a field named twice must match the same text both times. Fields session, "
-    "subject, group and timepoint fill those columns; any other field is a "
-    "covariate. Where the rule does not fit (time points such as 'day_7'), give a "
-    "regular expression with named groups instead, matched against the whole "
-    "relative path, e.g. '(?P<group>[^/]+)/(?P<subject>[^/]+)_(?P<timepoint>day_\\d+)"
-    "\\.nc'."
-)
-
-_FIELD = re.compile(r"\{(\w+)\}")
-
-
-def _pattern_regex(pattern: str) -> tuple[re.Pattern, list[str]]:
-    """The regular expression of a pattern (see :data:`PATTERN_HELP`) and its fields.
-
-    Each field becomes a greedy ``[^/]+`` (a field named again, a back-reference)."""
-    if not pattern.strip():
-        raise ValueError("the pattern is empty; give e.g. '{group}/{subject}.nc'")
-    if pattern.startswith("/"):
-        raise ValueError(
-            f"pattern {pattern!r} starts with '/': a pattern is a path relative to "
-            "the folder searched, e.g. '{group}/{subject}_{timepoint}.nc'"
-        )
-    parts: list[str] = []
-    fields: list[str] = []
-    pos, prev = 0, None
-    for m in _FIELD.finditer(pattern):
-        literal = pattern[pos : m.start()]
-        if "{" in literal or "}" in literal:
-            raise ValueError(
-                f"pattern {pattern!r}: {literal!r} has a brace that is not a field; "
-                "a field is {name} with letters, digits and '_' only"
-            )
-        f = m.group(1)
-        if prev is not None and not literal:
-            raise ValueError(
-                f"pattern {pattern!r}: fields {{{prev}}} and {{{f}}} touch, so "
-                "nothing says where one ends; put a separator between them, or give "
-                "a regular expression with named groups (regex=, --regex)"
-            )
-        parts.append(re.escape(literal))
-        parts.append(f"(?P={f})" if f in fields else f"(?P<{f}>[^/]+)")
-        if f not in fields:
-            fields.append(f)
-        pos, prev = m.end(), f
-    tail = pattern[pos:]
-    if "{" in tail or "}" in tail:
-        raise ValueError(
-            f"pattern {pattern!r}: {tail!r} has a brace that is not a field; a field "
-            "is {name} with letters, digits and '_' only"
-        )
-    parts.append(re.escape(tail))
-    return re.compile("".join(parts)), fields
-
-
-def _user_regex(regex: str | re.Pattern) -> tuple[re.Pattern, list[str]]:
-    """A user's regular expression and its named groups (the fields)."""
-    if isinstance(regex, re.Pattern):
-        compiled = regex
-    else:
-        try:
-            compiled = re.compile(str(regex))
-        except re.error as exc:
-            raise ValueError(
-                f"regex {regex!r} is not a valid regular expression ({exc})"
-            ) from None
-    fields = list(compiled.groupindex)
-    if not fields:
-        raise ValueError(
-            f"regex {compiled.pattern!r} has no named group; name the parts, e.g. "
-            "(?P<subject>[^/]+)_(?P<timepoint>[^/_]+)\\.nc"
-        )
-    return compiled, fields
-
-
-def _broad_layout(path: Path) -> bool:
-    """True for an HDF5 file with the variables of a BROAD trial (which
-    :func:`tiltlab.io.detect` may describe as a NetCDF-4 file, h5netcdf opening any
-    HDF5 file)."""
-    import h5py
-
-    from ..io.broad import _BROAD_VARS
-
-    try:
-        with h5py.File(path, "r") as f:
-            names = set(map(str, f.keys()))
-    except OSError:
-        return False
-    return all(k in names for k in _BROAD_VARS)
-
-
-def _reader_from_content(path: Path, label: str) -> str:
-    """The reader of a file, chosen from its content (:func:`tiltlab.io.detect`);
-    a file of another kind is refused, listing the readers to choose from."""
-    choices = ", ".join(r for r in READERS if r != "auto")
-    try:
-        with warnings.catch_warnings():  # a probe: the reader warns when it reads
-            warnings.simplefilter("ignore")
-            what = _io.detect(path)
-    except (OSError, ValueError) as exc:
-        raise ValueError(
-            f"{label}: cannot tell what it is ({' '.join(str(exc).split())}), so no "
-            f"reader can be chosen from its content; give reader= (--reader): one of "
-            f"{choices}, or auto (chosen when each session is read)"
-        ) from None
-    if what.startswith("tiltlab Recording"):
-        return "netcdf"
-    if what.startswith("tag-tools NetCDF"):
-        return "tagtools"
-    if what.startswith("BROAD trial"):
-        return "broad"
-    if what.startswith(("NetCDF-4 file", "HDF5 file")) and _broad_layout(path):
-        return "broad"
-    extra = ""
-    if what.startswith(("CSV", "TSV")):
-        extra = (
-            " (your own CSV: reader csv with reader_options, a column/unit mapping; "
-            "Fayat et al.'s CSV: fayat_csv or fayat_tumble)"
-        )
-    raise ValueError(
-        f"{label} looks like a {what}, for which tiltlab does not choose a reader; "
-        f"give reader= (--reader): one of {choices}{extra}"
-    )
-
-
-def init_manifest(
-    folder,
-    pattern: str | None = None,
-    *,
-    regex: str | re.Pattern | None = None,
-    reader: str | None = None,
-    group: str | Mapping[str, str] | None = None,
-    nested_subjects: bool = False,
-    groups: Sequence[str] | str | None = None,
-    timepoints: Sequence[str] | str | None = None,
-    reader_options: Mapping[str, Any] | None = None,
-    calibration: str | Mapping[str, str] | None = None,
-    out=None,
-) -> Manifest:
-    r"""Build a manifest from the files of a folder whose relative paths match a pattern.
-
-    Parameters
-    ----------
-    folder : path-like
-        Folder searched recursively.
-    pattern : str, optional
-        Relative path with named fields, e.g. ``"{group}/{subject}_{timepoint}.nc"``.
-        A field matches one or more characters other than ``/``; fields are read left
-        to right, each taking as much as it can, so a separator between two fields
-        splits the path at its *last* occurrence: ``A/rat_01_d0.nc`` is subject
-        ``rat_01`` at time point ``d0`` (the full grammar: :data:`PATTERN_HELP`).
-        Fields ``session``, ``subject``, ``group`` and ``timepoint`` fill those
-        columns, any other field becomes a covariate. ``subject`` (or ``session``) is
-        required. The session id is ``{subject}_{timepoint}`` (``{subject}`` without
-        a timepoint) unless the pattern has ``{session}``.
-    regex : str or re.Pattern, optional
-        Instead of ``pattern``: a regular expression matched against the whole relative
-        path (``/`` separators), whose named groups are the fields, e.g.
-        ``r"(?P<group>[^/]+)/(?P<subject>[^/]+)_(?P<timepoint>day_\d+)\.nc"``.
-    reader : str, optional
-        Reader of every file (see :data:`READERS`). Default: chosen for each file from
-        its content (:func:`tiltlab.io.detect`): ``netcdf`` for a tiltlab Recording,
-        ``tagtools`` for a tag-tools NetCDF, ``broad`` for a BROAD trial; any other
-        file is refused, naming it and the readers to choose from.
-    group : str or mapping, optional
-        The group when the pattern has no ``{group}`` field: one name for all, or a
-        mapping subject → group.
-    nested_subjects : bool
-        Subject ids restart in each group (``A/rat1_d0.nc`` and ``B/rat1_d0.nc`` are
-        two animals): name each subject ``<group>-<subject>`` (``A-rat1``), and a
-        ``{session}`` field's id likewise. Without it a subject found in two groups is
-        refused.
-    groups, timepoints : sequence of str, or str, optional
-        The study's declared groups and time points (a sequence, or a comma-separated
-        string); a file whose group or time point is not declared (a typo) is
-        refused, as by :func:`read_manifest`.
-    reader_options : mapping, optional
-        Reader options for every row (stored as JSON).
-    calibration : str or mapping, optional
-        Each subject's tumble test: a path pattern formatted with the row's fields
-        as found in the path (e.g. ``"calibration/{subject}_tumble.nc"``) or a mapping
-        subject → path; relative paths are relative to ``folder``.
-    out : path-like, optional
-        Write the manifest there (paths relative to its folder).
-
-    Returns
-    -------
-    Manifest
-        Validated as :func:`read_manifest` would; ``file`` and ``calibration`` relative
-        to the manifest's folder (``out``'s, else ``folder``) wherever a relative path
-        exists.
-
-    Raises
-    ------
-    FileNotFoundError
-        If ``folder`` does not exist.
-    ValueError
-        A bad pattern or regex, an unknown reader, a file whose reader cannot be
-        chosen from its content, no matching file.
-    ManifestError
-        What :func:`read_manifest` rejects (a subject in two groups, a session id or a
-        subject and time point twice, one recording twice, an undeclared group or time
-        point …), naming the file, as the manifest is not written yet.
-    """
-    folder = Path(folder).resolve()
-    if not folder.is_dir():
-        raise FileNotFoundError(f"{folder}: no such folder")
-    if reader is not None and reader not in READERS:
-        raise ValueError(f"unknown reader {reader!r}; known: {sorted(READERS)}")
-    if (pattern is None) == (regex is None):
-        raise ValueError(
-            "give a pattern (e.g. '{group}/{subject}_{timepoint}.nc') or a regex with "
-            "named groups, not both"
-            if pattern is not None
-            else "give a pattern (e.g. '{group}/{subject}_{timepoint}.nc') or a regex "
-            "with named groups"
-        )
-    if pattern is not None:
-        compiled, fields = _pattern_regex(str(pattern))
-        shown = repr(str(pattern))
-    else:
-        compiled, fields = _user_regex(regex)
-        shown = f"regex {compiled.pattern!r}"
-    if "subject" not in fields and "session" not in fields:
-        raise ValueError(f"pattern {shown} needs a {{subject}} or {{session}} field")
-    if "group" not in fields and group is None:
-        raise ValueError(
-            f"pattern {shown} has no {{group}} field: give group= (a name or a "
-            "mapping subject → group)"
-        )
-    rows, labels = [], []
-    for p in sorted(folder.rglob("*")):
-        if not p.is_file():
-            continue
-        rel = p.relative_to(folder).as_posix()
-        m = compiled.fullmatch(rel)
-        if m is None:
-            continue
-        label = f"file {rel!r}"
-        f = {k: ("" if v is None else str(v)) for k, v in m.groupdict().items()}
-        found = f.get("subject") or f.get("session", "")
-        tp = f.get("timepoint", "")
-        if "group" in f:
-            grp = f["group"]
-        elif isinstance(group, Mapping):
-            if found not in group:
-                raise ValueError(
-                    f"{label}: the group mapping has no entry for subject {found!r}"
-                )
-            grp = str(group[found])
-        else:
-            grp = str(group)
-        subject = f"{grp}-{found}" if nested_subjects else found
-        session = f.get("session", "")
-        if session and nested_subjects:
-            session = f"{grp}-{session}"
-        session = session or (f"{subject}_{tp}" if tp else subject)
-        cal = ""
-        if isinstance(calibration, Mapping):
-            cal = str(calibration.get(subject, calibration.get(found, "")))
-        elif calibration is not None:
-            try:
-                cal = str(calibration).format(**{**f, "subject": found, "group": grp})
-            except (KeyError, IndexError) as exc:
-                raise ValueError(
-                    f"calibration pattern {calibration!r} names {exc}, which is not a "
-                    f"field of the pattern ({', '.join(fields)})"
-                ) from None
-        row = {
-            "session": session,
-            "subject": subject,
-            "group": grp,
-            "timepoint": tp,
-            "file": str(p),
-            "reader": reader or _reader_from_content(p, label),
-            "reader_options": json.dumps(dict(reader_options or {}), sort_keys=True),
-            "calibration": str(session_path(cal, folder)) if cal else "",
-        }
-        row.update({k: v for k, v in f.items() if k not in row})
-        rows.append(row)
-        labels.append(label)
-    if not rows:
-        raise ValueError(f"no file under {folder} matches {shown}")
-    df = pd.DataFrame(rows)
-    base = Path(out).resolve().parent if out is not None else folder
-    for c in ("file", "calibration"):
-        df[c] = [_portable(v, base) if v else "" for v in df[c]]
-    name = Path(out).name if out is not None else "manifest"
-    table = _check_table(
-        df.astype(str),
-        base,
-        name,
-        groups,
-        timepoints=timepoints,
-        labels=labels,
-        restart_hint=_RESTART_INIT,
-    )
-    manifest = Manifest(table=table, root=base, path=None)
-    if out is not None:
-        out = manifest.to_csv(Path(out).resolve())
-        manifest = Manifest(table=table, root=base, path=out)
-    return manifest
