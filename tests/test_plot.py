@@ -207,17 +207,17 @@ def test_tukey_boxplot_and_group_lines():
     df = pd.DataFrame(
         {
             "group": np.repeat(["sham", "lesion"], 12),
-            "time_point": np.tile(["pre", "d1", "d7"], 8),
+            "timepoint": np.tile(["pre", "d1", "d7"], 8),
             "tilt": rng.normal(0, 5, 24),
         }
     )
-    ax = plot.tukey_boxplot(df, "tilt", by="time_point", hue="group", units="deg")
-    assert ax.get_ylabel() == "tilt (°)" and ax.get_xlabel() == "time_point"
+    ax = plot.tukey_boxplot(df, "tilt", by="timepoint", hue="group", units="deg")
+    assert ax.get_ylabel() == "tilt (°)" and ax.get_xlabel() == "timepoint"
     assert legend_texts(ax) == ["sham", "lesion"]
     assert [t.get_text() for t in ax.get_xticklabels()] == ["pre", "d1", "d7"]
     ds = xr.Dataset.from_dataframe(df.set_index(pd.RangeIndex(24, name="session")))
     ds["tilt"].attrs["units"] = "deg"
-    ax = plot.group_lines(ds, "tilt", x="time_point", hue="group")
+    ax = plot.group_lines(ds, "tilt", x="timepoint", hue="group")
     assert ax.get_ylabel() == "tilt (°)" and legend_texts(ax) == ["sham", "lesion"]
 
 

@@ -390,7 +390,7 @@ def test_cohort_round_trips_and_is_independent_of_workers(tmp_path):
     assert set(c1.sessions.columns) >= {
         "subject",
         "group",
-        "time_point",
+        "timepoint",
         "hours",
         "file",
     }
@@ -401,14 +401,14 @@ def test_cohort_round_trips_and_is_independent_of_workers(tmp_path):
     ):
         assert (
             rec.attrs["subject"] == row["subject"]
-            and rec.attrs["session"] == row["time_point"]
+            and rec.attrs["session"] == row["timepoint"]
         )
         assert rec.identical(rec2)
         assert rec.sizes["time"] == 400
         n += 1
     assert n == 28
     rec = c1.load("Arsanilate01", "7d")
-    truth = c1.truth.set_index(["subject", "time_point"]).loc[("Arsanilate01", "7d")]
+    truth = c1.truth.set_index(["subject", "timepoint"]).loc[("Arsanilate01", "7d")]
     g0 = np.asarray(rec.attrs["baseline_tilt"])
     assert math.degrees(math.asin(-g0[1])) == pytest.approx(
         truth["tilt_to_xz_deg_true"], abs=1e-9
@@ -422,7 +422,7 @@ def test_cohort_round_trips_and_is_independent_of_workers(tmp_path):
 def test_planted_effects_follow_the_paper_time_courses():
     plan = session_plan(CohortDesign(), seed=0, duration_s=1200.0, fs=100.0)
     assert len(plan) == 58 * 7
-    m = plan.groupby(["group", "time_point"]).mean(numeric_only=True)
+    m = plan.groupby(["group", "timepoint"]).mean(numeric_only=True)
     ars = m.loc["Arsanilate"]
     kai = m.loc["Kainate"]
     # arsanilate: tilt peaks at 7 d near 40° and partially recovers; circling is late

@@ -70,7 +70,7 @@ def tukey_boxplot(
     value : str
         Feature column to plot.
     by : str
-        Column with the categories on the x axis (e.g. ``"time_point"``).
+        Column with the categories on the x axis (e.g. ``"timepoint"``).
     hue : str, optional
         Column with side-by-side boxes within each category (e.g. ``"group"``), with a legend.
     ax : matplotlib.axes.Axes, optional
@@ -164,7 +164,7 @@ def group_lines(
     value : str
         Feature column.
     x : str
-        Column on the x axis (e.g. ``"time_point"``), in ``order``.
+        Column on the x axis (e.g. ``"timepoint"``), in ``order``.
     hue : str
         Column with one line per value (e.g. ``"group"``), with a legend.
     ax : matplotlib.axes.Axes, optional

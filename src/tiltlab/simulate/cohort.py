@@ -28,7 +28,7 @@ Directory layout::
                       session, subject, group, timepoint, file, reader (netcdf),
                       reader_options (empty), calibration (the animal's tumble test)
                       and the covariate hours
-      sessions.csv    one row per session: subject, group, time_point, hours, file
+      sessions.csv    one row per session: subject, group, timepoint, hours, file
       truth.csv       planted and realised effects per session (realised: state fraction
                       immobile, fraction of true angular speed < 12 °/s, angle to the xz
                       plane of the baseline tilt point and of the mean immobile tilt,
@@ -36,7 +36,7 @@ Directory layout::
                       of :mod:`tiltlab.cohort` applied to the true motion
                       (``*_true`` columns, see :func:`_true_features`)
       design.json     design, effect tables, seed, duration, fs
-      sessions/<subject>_<time_point>.nc   one Recording per session (tiltlab.io.save_netcdf)
+      sessions/<subject>_<timepoint>.nc   one Recording per session (tiltlab.io.save_netcdf)
       calibration/<subject>_tumble.nc      one tumble test per animal, recorded with the
                                            animal's IMU (Fayat App. A.1)
 
@@ -311,7 +311,7 @@ def session_plan(
                 {
                     "subject": subj,
                     "group": grp,
-                    "time_point": tp,
+                    "timepoint": tp,
                     "hours": float(hr),
                     "session": f"{subj}_{tp}",
                     "file": f"sessions/{subj}_{tp}.nc",
@@ -413,7 +413,7 @@ def _simulate_one(row: dict, out_dir: str, keep_true: bool) -> dict:
     )
     attrs = {
         "subject": row["subject"],
-        "session": row["time_point"],
+        "session": row["timepoint"],
         "group": row["group"],
         "hours_after_lesion": row["hours"],
         "lesion_side": row["lesion_side"],
@@ -542,7 +542,7 @@ def simulate_cohort(
     bar.close()
     real = pd.DataFrame(results).set_index("file").loc[plan["file"]].reset_index()
     truth = plan.merge(real, on="file")
-    plan[["subject", "group", "time_point", "hours", "file"]].to_csv(
+    plan[["subject", "group", "timepoint", "hours", "file"]].to_csv(
         path / "sessions.csv", index=False
     )
     # the cohort manifest of tiltlab.cohort (written here: the simulator sits below it)
@@ -551,7 +551,7 @@ def simulate_cohort(
             "session": plan["session"],
             "subject": plan["subject"],
             "group": plan["group"],
-            "timepoint": plan["time_point"],
+            "timepoint": plan["timepoint"],
             "file": plan["file"],
             "reader": "netcdf",
             "reader_options": "",
@@ -588,16 +588,16 @@ class Cohort:
         return len(self.sessions)
 
     def load(
-        self, subject: str, time_point: str, *, validate: bool = True
+        self, subject: str, timepoint: str, *, validate: bool = True
     ) -> xr.Dataset:
         """One session's Recording."""
         sel = self.sessions[
             (self.sessions.subject == subject)
-            & (self.sessions.time_point == time_point)
+            & (self.sessions.timepoint == timepoint)
         ]
         if len(sel) != 1:
             raise KeyError(
-                f"no unique session for subject={subject!r}, time_point={time_point!r}"
+                f"no unique session for subject={subject!r}, timepoint={timepoint!r}"
             )
         return _io.load_netcdf(self.path / sel.iloc[0]["file"], validate=validate)
 
@@ -611,15 +611,15 @@ class Cohort:
 
 def load_cohort(path) -> Cohort:
     """Read a cohort directory (``sessions.csv`` with columns subject, group,
-    time_point, hours, file; optional ``truth.csv`` and ``design.json``)."""
+    timepoint, hours, file; optional ``truth.csv`` and ``design.json``)."""
     path = Path(path)
     table = path / "sessions.csv"
     if not table.is_file():
         raise FileNotFoundError(f"{path}: no sessions.csv, not a cohort directory")
     sessions = pd.read_csv(
-        table, dtype={"subject": str, "group": str, "time_point": str, "file": str}
+        table, dtype={"subject": str, "group": str, "timepoint": str, "file": str}
     )
-    missing = {"subject", "group", "time_point", "file"} - set(sessions.columns)
+    missing = {"subject", "group", "timepoint", "file"} - set(sessions.columns)
     if missing:
         raise ValueError(f"{table}: missing column(s) {sorted(missing)}")
     absent = [f for f in sessions["file"] if not (path / f).is_file()]
