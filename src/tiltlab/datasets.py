@@ -38,6 +38,7 @@ __all__ = [
     "fetch",
     "broad_trials",
     "broad_trial_groups",
+    "broad_trial_kind",
     "load_broad_trial",
     "load_fayat_example",
     "load_fayat_tumble",
@@ -202,6 +203,54 @@ def broad_trial_groups() -> dict[int, list[str]]:
         key = Path(name).stem
         out[n] = list(info[key]["groups"]) if key in info else []
     return out
+
+
+_BROAD_MOTIONS = ("rotation", "translation", "combined")
+
+
+def broad_trial_kind(trial: int, groups: dict[int, list[str]] | None = None) -> str:
+    """The motion of an undisturbed BROAD trial in words: its pace and its kind of
+    motion, e.g. ``"fast rotation"`` or ``"slow translation"``.
+
+    Parameters
+    ----------
+    trial : int
+        A BROAD trial number.
+    groups : dict, optional
+        Trial number → group labels, as returned by :func:`broad_trial_groups` (read
+        from ``trials.json`` when omitted; pass it to describe many trials).
+
+    Returns
+    -------
+    str
+        ``"<pace> <motion>"``: pace ``"fast"`` for the trials in BROAD's ``fast``
+        group, else ``"slow"``; motion the trial's group among ``rotation``,
+        ``translation`` and ``combined``.
+
+    Raises
+    ------
+    DataError
+        An unknown trial, or a trial in none of the motion groups (the disturbed
+        trials).
+
+    Examples
+    --------
+    >>> groups = {6: ["all_trials", "undisturbed", "rotation", "fast", "no_breaks"]}
+    >>> broad_trial_kind(6, groups)
+    'fast rotation'
+    """
+    groups = broad_trial_groups() if groups is None else groups
+    if trial not in groups:
+        raise DataError(f"no BROAD trial {trial!r}; trials: {sorted(groups)}")
+    labels = groups[trial]
+    motion = next((g for g in _BROAD_MOTIONS if g in labels), None)
+    if motion is None:
+        raise DataError(
+            f"BROAD trial {trial} ({', '.join(labels)}) is in none of the motion "
+            f"groups {_BROAD_MOTIONS}"
+        )
+    pace = "fast" if "fast" in labels else "slow"
+    return f"{pace} {motion}"
 
 
 def load_broad_trial(trial: int | str) -> xr.Dataset:

@@ -38,7 +38,9 @@ References
 Modules
 -------
 :mod:`~tiltlab.evaluate.errors` (error definitions and statistics, BROAD's RMSEs),
-:mod:`~tiltlab.evaluate.selection` (grid search over methods' parameters, LOTO) and
+:mod:`~tiltlab.evaluate.selection` (grid search over methods' parameters, LOTO),
+:mod:`~tiltlab.evaluate.recipes` (a grid's best parameters, methods as estimators,
+the tilt difference between two methods, errors pooled over recordings) and
 :mod:`~tiltlab.evaluate.mocap` (the motion-capture reference).
 """
 
@@ -60,6 +62,7 @@ from .errors import (
     tilt_rmse,
 )
 from .mocap import mocap_reference
+from .recipes import best_params, estimator, pooled_errors, tilt_difference_rms
 from .selection import error_table, grid_search, loto, loto_summary, optimum
 
 __all__ = [
@@ -82,6 +85,10 @@ __all__ = [
     "loto",
     "error_table",
     "loto_summary",
+    "best_params",
+    "estimator",
+    "tilt_difference_rms",
+    "pooled_errors",
     "pairwise_tilt_rms",
     "mocap_reference",
 ]

@@ -592,8 +592,7 @@ class Cohort:
     ) -> xr.Dataset:
         """One session's Recording."""
         sel = self.sessions[
-            (self.sessions.subject == subject)
-            & (self.sessions.timepoint == timepoint)
+            (self.sessions.subject == subject) & (self.sessions.timepoint == timepoint)
         ]
         if len(sel) != 1:
             raise KeyError(
