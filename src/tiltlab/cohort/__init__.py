@@ -14,6 +14,11 @@ r"""Cohorts: from a lab's folder of sessions to one feature table (layer 7).
   orientation → tilt → features (immobility, visited sphere, vMF mean tilt and its
   sagittal angle, circling, angular speed, DBA, time tilted) of one session (Fayat et
   al. 2021, §2.7–2.10, §3.3–3.4);
+* :mod:`~tiltlab.cohort.labels` — :func:`feature_name`, :func:`feature_units` and
+  :func:`feature_label`: a feature's short name and units for tables and axes;
+* :mod:`~tiltlab.cohort.lookup` — :func:`session_row` (a subject's session at a time
+  point) and :func:`load_session_tilt` (its corrected Recording and tilt, as the
+  pipeline computes them);
 * :mod:`~tiltlab.cohort.run` — :func:`run_cohort` (serial, local processes or
   ``dask.distributed``, one code path; a per-session disk cache; failed sessions
   recorded, never lost), :func:`summary`, :func:`save_features`,
@@ -42,6 +47,14 @@ References
 from .config import FeatureConfig
 from .features import empty_features, feature_specs, session_features, session_tilt
 from .initialize import init_manifest
+from .labels import (
+    FEATURE_NAMES,
+    UNIT_TEXT,
+    feature_label,
+    feature_name,
+    feature_units,
+)
+from .lookup import load_session_tilt, session_row
 from .manifest import (
     OPTIONAL_COLUMNS,
     READERS,
@@ -71,6 +84,13 @@ __all__ = [
     "empty_features",
     "session_features",
     "session_tilt",
+    "FEATURE_NAMES",
+    "UNIT_TEXT",
+    "feature_name",
+    "feature_units",
+    "feature_label",
+    "session_row",
+    "load_session_tilt",
     "REQUIRED_COLUMNS",
     "OPTIONAL_COLUMNS",
     "READERS",

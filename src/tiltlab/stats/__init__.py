@@ -19,7 +19,10 @@ One implementation each:
   baseline, test directions and families read from a cohort table (:class:`StudyDesign`);
 * :mod:`~tiltlab.stats.tables` — :func:`between_groups`, :func:`against_baseline`
   (tidy tables from a cohort Dataset/DataFrame) and :func:`format_table` (Tables
-  A1–A8 layout).
+  A1–A8 layout);
+* :mod:`~tiltlab.stats.summaries` — :func:`group_quantiles`, :func:`significant_cells`,
+  :func:`with_published` (our p-values next to the printed Tables A1–A2) and
+  :func:`recovery_table` (planted versus estimated differences of a simulated cohort).
 
 Example
 -------
@@ -56,7 +59,13 @@ from .nonparametric import (
     signed_rank_p_lattice,
     wilcoxon_signed_rank,
 )
-from .published import FAYAT_DESIGN, FAYAT_TABLES, FAYAT_TIME_POINTS, fayat_table
+from .published import (
+    FAYAT_DESIGN,
+    FAYAT_FEATURE_TABLES,
+    FAYAT_TABLES,
+    FAYAT_TIME_POINTS,
+    fayat_table,
+)
 from .power import (
     PowerResult,
     animals_needed,
@@ -65,6 +74,12 @@ from .power import (
     normal_shift_superiority,
     observed_shift,
     power_by_simulation,
+)
+from .summaries import (
+    group_quantiles,
+    recovery_table,
+    significant_cells,
+    with_published,
 )
 from .tables import (
     COLOURS,
@@ -82,6 +97,7 @@ __all__ = [
     "session_table",
     "study_design",
     "FAYAT_DESIGN",
+    "FAYAT_FEATURE_TABLES",
     "FAYAT_TABLES",
     "FAYAT_TIME_POINTS",
     "fayat_table",
@@ -121,4 +137,8 @@ __all__ = [
     "against_baseline",
     "check_cells",
     "format_table",
+    "group_quantiles",
+    "significant_cells",
+    "with_published",
+    "recovery_table",
 ]

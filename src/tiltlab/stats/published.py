@@ -16,9 +16,24 @@ from __future__ import annotations
 
 import pandas as pd
 
-__all__ = ["FAYAT_DESIGN", "FAYAT_TIME_POINTS", "FAYAT_TABLES", "fayat_table"]
+__all__ = [
+    "FAYAT_DESIGN",
+    "FAYAT_FEATURE_TABLES",
+    "FAYAT_TIME_POINTS",
+    "FAYAT_TABLES",
+    "fayat_table",
+]
 
 FAYAT_TIME_POINTS: tuple[str, ...] = ("1h", "1d", "2d", "7d", "14d", "28d")
+
+#: The appendix tables of each feature: (between groups, Mann–Whitney; against
+#: baseline, Wilcoxon signed rank).
+FAYAT_FEATURE_TABLES: dict[str, tuple[str, str]] = {
+    "immobile_fraction": ("A1", "A2"),
+    "visited_fraction_moving": ("A3", "A4"),
+    "tilt_immobile_sagittal_deg": ("A5", "A6"),
+    "circling_index": ("A7", "A8"),
+}
 
 #: Fayat et al.'s analysis design (§2.4, §3.4, Tables A1–A8) as keywords of
 #: :func:`tiltlab.stats.study_design`: the anaesthesia-only control group, one family
