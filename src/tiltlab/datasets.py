@@ -44,6 +44,7 @@ __all__ = [
     "load_fayat_tumble",
     "citation",
     "load",
+    "source_name",
 ]
 
 ENV_DATA_DIR = "TILTLAB_DATA_DIR"
@@ -333,3 +334,33 @@ def load(source: str | os.PathLike, **options) -> xr.Dataset:
         f"don't know how to read {spec!r}: use broad:N, fayat:example, fayat:tumble, "
         "or a .nc / .hdf5 / .mat file (tiltlab.io.detect says what a file looks like)"
     )
+
+
+def source_name(source: str | os.PathLike) -> str:
+    """A data source as a reader sees it: a trial name, or a file name.
+
+    Chapters print this in place of the full source, so that a path to a local file
+    does not spill the folder it lives in into the book.
+
+    Parameters
+    ----------
+    source : str or path
+        A data-source string as :func:`load` takes it (``"broad:2"``,
+        ``"fayat:example"``) or the path of a file.
+
+    Returns
+    -------
+    str
+        The source unchanged when it names no file (no suffix), else the file's name
+        without its folder.
+
+    Examples
+    --------
+    >>> source_name("broad:2")
+    'broad:2'
+    >>> source_name("/data/lab/rat7_day3.nc")
+    'rat7_day3.nc'
+    """
+    text = os.fspath(source) if isinstance(source, os.PathLike) else str(source)
+    path = Path(text)
+    return path.name if path.suffix else text

@@ -11,7 +11,8 @@ Supported formats
 * BROAD benchmark trials, ``.hdf5`` and MATLAB ``.mat`` layouts (``read_broad``).
 * A generic CSV with a column/unit mapping (``read_csv``), the mapping given as a dict
   or a JSON file (``read_csv_mapping``); time columns in s, ms, µs, ns or date-times,
-  on a regular grid or resampled from a jittery clock (``clock="resample"``).
+  on a regular grid or resampled from a jittery clock (``clock="resample"``);
+  ``try_read`` returns why a file is refused instead of raising.
 * Exports with one file per sensor, each on its own clock (``read_multi``).
 * Mappings for public recordings from other labs (``mapping_template``).
 * tag-tools (animaltags) NetCDF archives, NetCDF-4 or NetCDF-3 (``read_tagtools``;
@@ -29,6 +30,7 @@ from __future__ import annotations
 
 from ._common import IntegrityError, ReadError
 from .broad import read_broad
+from .check import try_read
 from .csv import FS_RANGE, GAP_POLICIES, TIME_UNITS, read_csv, read_csv_mapping
 from .detect import detect, read
 from .fayat import read_fayat_imu, read_fayat_tumble
@@ -55,6 +57,7 @@ __all__ = [
     "read_broad",
     "read_csv",
     "read_csv_mapping",
+    "try_read",
     "read_tagtools",
     "write_tagtools",
     "read_matrix",

@@ -13,7 +13,8 @@ Submodules
   any bandwidth, even at the grid's poles), reference bandwidth, cumulative isopleths,
   stationarity check (Benhamou 2023, §7);
 * :mod:`~tiltlab.sphere.residence` — residence time and number of visits
-  (Benhamou 2023, App. C).
+  (Benhamou 2023, App. C);
+* :mod:`~tiltlab.sphere.text` — directions as printed text.
 
 Everything is re-exported here: ``from tiltlab import sphere; sphere.tilt_map(g)``.
 
@@ -74,6 +75,7 @@ from .kde import (
     stationarity_thirds,
 )
 from .residence import Residence, passage_times, residence, residence_series
+from .text import format_direction
 
 __all__ = [
     "EDGE_EPS",
@@ -120,4 +122,5 @@ __all__ = [
     "passage_times",
     "residence",
     "residence_series",
+    "format_direction",
 ]

@@ -46,6 +46,8 @@ Modules
   simultaneous rotations, sub-arcs, the exact constant-rate step (Eqs. 10–13), head
   relative to body (App. B), cap passage (App. C);
 * :mod:`~tiltlab.trig.deadreckoning` — local coordinates and dead reckoning (§8);
+* :mod:`~tiltlab.trig.anchors` — regularly spaced anchors, and dead reckoning anchored
+  on a known track (§8);
 * :mod:`~tiltlab.trig.oscillations` — crossing times and oscillation statistics (§9).
 
 Benhamou's frames, rotation matrices and sign conventions live in
@@ -126,6 +128,7 @@ from ..frames import (
     unit_vector,
 )
 from ._types import Arc, OscillationStats, Posture, Rotations
+from .anchors import anchor_steps, dead_reckon_every
 from .angles import angles_from_matrix, angles_from_quaternion, wrap_angle
 from .arcs import *  # noqa: F401,F403
 from .arcs import __all__ as _arcs
@@ -172,6 +175,8 @@ __all__ = [
     *_arcs,
     *_rot,
     *_dr,
+    "anchor_steps",
+    "dead_reckon_every",
     *_osc,
     # result types
     "Orientation",
