@@ -25,6 +25,7 @@ Submodules (all public names are re-exported here):
 * :mod:`~tiltlab.calibration.alignment` — head frame from markers, marker QC, Kabsch
   alignment, mounting rotation;
 * :mod:`~tiltlab.calibration.apply` — the :class:`Calibration` record and :func:`calibrate`.
+* :mod:`~tiltlab.calibration.summaries` — per-sample norm error, Allan noise table.
 * :mod:`~tiltlab.calibration.published` — LaCanna's drift tables (not re-exported here).
 """
 
@@ -43,7 +44,9 @@ from .magnetometer import *  # noqa: F401,F403
 from .magnetometer import __all__ as _f
 from .static import *  # noqa: F401,F403
 from .static import __all__ as _g
+from .summaries import *  # noqa: F401,F403
+from .summaries import __all__ as _s
 from .temperature import *  # noqa: F401,F403
 from .temperature import __all__ as _h
 
-__all__ = ["CalibrationError", *_a, *_e, *_b, *_c, *_d, *_f, *_g, *_h]
+__all__ = ["CalibrationError", *_a, *_e, *_b, *_c, *_d, *_f, *_g, *_h, *_s]

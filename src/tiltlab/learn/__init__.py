@@ -39,6 +39,7 @@ from .training import (
 )
 from .published import ZAHEER_TABLE2, ZAHEER_TABLE3
 from .cv import BASELINES, check_files, compare, cross_validate, folds, learned_estimate
+from .tables import config_table, layer_settings, layer_table
 
 __all__ = [
     "Sequence",
@@ -69,4 +70,7 @@ __all__ = [
     "learned_estimate",
     "ZAHEER_TABLE2",
     "ZAHEER_TABLE3",
+    "config_table",
+    "layer_settings",
+    "layer_table",
 ]
