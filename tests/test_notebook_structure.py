@@ -204,3 +204,25 @@ def test_intro_lists_every_chapters_parameters():
             f"{path.name}: the introduction lists {sorted(listed)}, "
             f"the chapter declares {sorted(declared)}"
         )
+
+
+def test_chapters_narrate_and_the_package_computes(chapter):
+    """No function is defined in a chapter outside the worked solutions: analysis
+    helpers live in the package, with tests."""
+    path, cells = chapter
+    defined = [
+        node.name
+        for c in cells
+        if c["cell_type"] == "code" and not _src(c).lstrip().startswith("# Solution")
+        for node in ast.walk(
+            ast.parse(
+                "\n".join(
+                    line
+                    for line in _src(c).splitlines()
+                    if not line.lstrip().startswith(("%", "!"))
+                )
+            )
+        )
+        if isinstance(node, ast.FunctionDef | ast.AsyncFunctionDef)
+    ]
+    assert not defined, f"{path.name}: functions defined in the chapter: {defined}"
