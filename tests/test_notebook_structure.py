@@ -226,3 +226,15 @@ def test_chapters_narrate_and_the_package_computes(chapter):
         if isinstance(node, ast.FunctionDef | ast.AsyncFunctionDef)
     ]
     assert not defined, f"{path.name}: functions defined in the chapter: {defined}"
+
+
+def test_chapters_read_in_short_cells(chapter):
+    """Each code cell does one thing: at most 25 lines, about 12 on average."""
+    path, cells = chapter
+    sizes = [
+        len(_src(c).strip().splitlines()) for c in cells if c["cell_type"] == "code"
+    ]
+    long = [(i, n) for i, n in enumerate(sizes) if n > 25]
+    assert not long, f"{path.name}: code cells over 25 lines (index, lines): {long}"
+    mean = sum(sizes) / len(sizes)
+    assert mean <= 12, f"{path.name}: {mean:.1f} lines per code cell on average"
