@@ -1,4 +1,4 @@
-"""Tests of the helpers chapters 3 and 5 call: ``calibration.norm_error``,
+"""Tests of the helpers chapters 3 and 5 call: ``calibration.recording_norm_error``,
 ``calibration.allan_noise_table``, ``learn.layer_settings``, ``learn.layer_table`` and
 ``learn.config_table``."""
 
@@ -29,30 +29,34 @@ def _acc(n=50, seed=0):
     return a / np.linalg.norm(a, axis=1, keepdims=True) * rng.uniform(0.9, 1.1, (n, 1))
 
 
-def test_norm_error_matches_definition_and_converts_units():
+def test_recording_norm_error_matches_definition_and_converts_units():
     a = _acc()
     want = np.abs(1 - np.linalg.norm(a, axis=1))
-    np.testing.assert_allclose(C.norm_error(a), want)
-    np.testing.assert_allclose(C.norm_error(a * 9.80665, units="m/s^2"), want)
+    np.testing.assert_allclose(C.recording_norm_error(a), want)
+    np.testing.assert_allclose(C.recording_norm_error(a * 9.80665, units="m/s^2"), want)
     rec = make_recording(a * 9.80665, None, 100.0, acc_units="m/s^2")
-    np.testing.assert_allclose(C.norm_error(rec), want)
-    np.testing.assert_allclose(C.norm_error(rec.acc), want)
+    np.testing.assert_allclose(C.recording_norm_error(rec), want)
+    np.testing.assert_allclose(C.recording_norm_error(rec.acc), want)
 
 
-def test_norm_error_of_a_calibrated_recording_is_smaller():
+def test_recording_norm_error_of_a_calibrated_recording_is_smaller():
     a = _acc() / np.linalg.norm(_acc(), axis=1, keepdims=True) + [0.05, 0.0, 0.0]
-    assert C.norm_error(a - [0.05, 0.0, 0.0]).max() < 1e-12 < C.norm_error(a).mean()
+    assert (
+        C.recording_norm_error(a - [0.05, 0.0, 0.0]).max()
+        < 1e-12
+        < C.recording_norm_error(a).mean()
+    )
 
 
-def test_norm_error_nan_passes_and_bad_shapes_fail():
+def test_recording_norm_error_nan_passes_and_bad_shapes_fail():
     a = _acc(5)
     a[2, 1] = np.nan
-    e = C.norm_error(a)
+    e = C.recording_norm_error(a)
     assert np.isnan(e[2]) and np.isfinite(np.delete(e, 2)).all()
     with pytest.raises(ValueError):
-        C.norm_error(np.ones((5, 2)))
+        C.recording_norm_error(np.ones((5, 2)))
     with pytest.raises(Exception):
-        C.norm_error(np.ones((5, 3)), units="furlong")
+        C.recording_norm_error(np.ones((5, 3)), units="furlong")
 
 
 # ------------------------------------------------------------------ allan_noise_table

@@ -18,3 +18,29 @@ def test_no_module_over_800_lines():
     assert not too_long, (
         f"modules over {MAX_LINES} lines (split them by responsibility): {too_long}"
     )
+
+
+def test_no_name_means_two_things_in_a_package():
+    """Within a package, two submodules never export the same name for different
+    objects (a star import would silently let one shadow the other)."""
+    import importlib
+    import pkgutil
+
+    import tiltlab
+
+    clashes = []
+    for pkg in pkgutil.walk_packages(tiltlab.__path__, "tiltlab."):
+        if not pkg.ispkg:
+            continue
+        package = importlib.import_module(pkg.name)
+        seen: dict[str, tuple[str, object]] = {}
+        for sub in pkgutil.iter_modules(package.__path__, pkg.name + "."):
+            if sub.name.rsplit(".", 1)[1].startswith("__"):
+                continue
+            module = importlib.import_module(sub.name)
+            for name in getattr(module, "__all__", []):
+                obj = getattr(module, name, None)
+                if name in seen and seen[name][1] is not obj:
+                    clashes.append(f"{name}: {seen[name][0]} and {sub.name}")
+                seen.setdefault(name, (sub.name, obj))
+    assert not clashes, f"one name, two meanings: {clashes}"

@@ -12,7 +12,7 @@ import pandas as pd
 from .drift import AllanNoise
 from ._util import read_in
 
-__all__ = ["norm_error", "allan_noise_table"]
+__all__ = ["recording_norm_error", "allan_noise_table"]
 
 #: row labels of :func:`allan_noise_table` (a gyroscope in deg/s)
 ALLAN_ROWS = {
@@ -22,7 +22,7 @@ ALLAN_ROWS = {
 }
 
 
-def norm_error(data, *, units: str | None = None) -> np.ndarray:
+def recording_norm_error(data, *, units: str | None = None) -> np.ndarray:
     """Distance of the acceleration norm from 1 g, per sample.
 
     At rest an accelerometer measures gravity alone, so :math:`|1 - \\|\\mathbf a\\||`
@@ -43,9 +43,9 @@ def norm_error(data, *, units: str | None = None) -> np.ndarray:
 
     Examples
     --------
-    >>> norm_error([[0.0, 0.0, 1.02], [0.0, 0.6, 0.8]]).round(3)
+    >>> recording_norm_error([[0.0, 0.0, 1.02], [0.0, 0.6, 0.8]]).round(3)
     array([0.02, 0.  ])
-    >>> norm_error([[0.0, 0.0, 9.80665]], units="m/s^2")
+    >>> recording_norm_error([[0.0, 0.0, 9.80665]], units="m/s^2")
     array([0.])
     """
     s, _ = read_in(
