@@ -132,7 +132,18 @@ def _clip1(x):
 
 
 def wrap_angle(angle) -> np.ndarray:
-    """Wrap angles (rad) to (−π, π]."""
+    """Wrap angles (rad) to (−π, π].
+
+    Parameters
+    ----------
+    angle : array_like
+        Angles in rad, any shape; NaN propagates, infinite values raise.
+
+    Returns
+    -------
+    numpy.ndarray
+        The equivalent angles in rad, in (−π, π], with the shape of ``angle``.
+    """
     a = _angle(angle, "angle")
     w = np.mod(a + np.pi, 2 * np.pi) - np.pi
     return np.where(w == -np.pi, np.pi, w)
@@ -160,6 +171,16 @@ def R1(angle) -> np.ndarray:
     r"""Benhamou's rotation about the first axis (X or U), counter-clockwise: shape (..., 3, 3).
 
     :math:`R_1(\varphi) = \begin{pmatrix}1&0&0\\0&\cos\varphi&-\sin\varphi\\0&\sin\varphi&\cos\varphi\end{pmatrix}`.
+
+    Parameters
+    ----------
+    angle : array_like, shape (...)
+        Rotation angles in rad; finite (NaN propagates).
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., 3, 3)
+        Rotation matrices, one per angle.
     """
     return _rot(angle, 1, 2, 1.0)
 
@@ -170,17 +191,52 @@ def R2(angle) -> np.ndarray:
     :math:`R_2(\varphi) = \begin{pmatrix}\cos\varphi&0&-\sin\varphi\\0&1&0\\\sin\varphi&0&\cos\varphi\end{pmatrix}`,
     i.e. the usual right-handed :math:`R_y(-\varphi)`, so that a positive angle raises
     the first axis (positive elevation = nose up).
+
+    Parameters
+    ----------
+    angle : array_like, shape (...)
+        Rotation angles in rad; finite (NaN propagates).
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., 3, 3)
+        Rotation matrices, one per angle.
     """
     return _rot(angle, 0, 2, 1.0)
 
 
 def R3(angle) -> np.ndarray:
-    r"""Benhamou's rotation about the third axis (Z or W), counter-clockwise: shape (..., 3, 3)."""
+    r"""Benhamou's rotation about the third axis (Z or W), counter-clockwise: shape (..., 3, 3).
+
+    Parameters
+    ----------
+    angle : array_like, shape (...)
+        Rotation angles in rad; finite (NaN propagates).
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., 3, 3)
+        Rotation matrices, one per angle.
+    """
     return _rot(angle, 0, 1, 1.0)
 
 
 def unit_vector(xi, psi) -> np.ndarray:
-    r"""Benhamou's :math:`[\xi\bullet\psi] = (\cos\xi\cos\psi, \sin\xi\cos\psi, \sin\psi)`, shape (..., 3)."""
+    r"""Benhamou's :math:`[\xi\bullet\psi] = (\cos\xi\cos\psi, \sin\xi\cos\psi, \sin\psi)`, shape (..., 3).
+
+    Parameters
+    ----------
+    xi : array_like
+        Azimuth-like angle ξ in rad, measured from the first axis towards the second.
+    psi : array_like
+        Elevation-like angle ψ in rad, above the plane of the first two axes. ``xi``
+        and ``psi`` broadcast.
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., 3)
+        Unit vectors, with the broadcast shape of ``xi`` and ``psi`` plus a last axis.
+    """
     xi, psi = np.broadcast_arrays(_angle(xi, "xi"), _angle(psi, "psi"))
     return np.stack(
         [np.cos(xi) * np.cos(psi), np.sin(xi) * np.cos(psi), np.sin(psi)], axis=-1
@@ -192,6 +248,18 @@ def spherical_coords(v) -> tuple[np.ndarray, np.ndarray]:
 
     ψ is computed as :math:`\mathrm{atan2}(v_z, \sqrt{v_x^2+v_y^2})` (accurate near ±π/2);
     ξ = atan2(v_y, v_x) is 0 on the poles (documented fallback).
+
+    Parameters
+    ----------
+    v : array_like, shape (..., 3)
+        Vectors (any length and unit).
+
+    Returns
+    -------
+    xi : numpy.ndarray, shape (...)
+        Azimuth-like angles ξ in rad, in (−π, π].
+    psi : numpy.ndarray, shape (...)
+        Elevation-like angles ψ in rad, in [−π/2, π/2].
     """
     v = _vec3(v, "v")
     return np.arctan2(v[..., 1], v[..., 0]), np.arctan2(
@@ -200,12 +268,34 @@ def spherical_coords(v) -> tuple[np.ndarray, np.ndarray]:
 
 
 def to_benhamou_acc(acc) -> np.ndarray:
-    """Specific force (tiltlab, +1 g on the up axis) → Benhamou's acceleration sign (−g on the up axis)."""
+    """Specific force (tiltlab, +1 g on the up axis) → Benhamou's acceleration sign (−g on the up axis).
+
+    Parameters
+    ----------
+    acc : array_like, shape (..., 3)
+        Specific force in tiltlab's sign, in any unit (g or m/s², kept).
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., 3)
+        The acceleration in Benhamou's sign (``−acc``), same unit.
+    """
     return -_vec3(acc, "acc")
 
 
 def from_benhamou_acc(acc) -> np.ndarray:
-    """Benhamou's acceleration sign (−g on the up axis) → specific force (tiltlab)."""
+    """Benhamou's acceleration sign (−g on the up axis) → specific force (tiltlab).
+
+    Parameters
+    ----------
+    acc : array_like, shape (..., 3)
+        Acceleration in Benhamou's sign, in any unit (g or m/s², kept).
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., 3)
+        The specific force in tiltlab's sign (``−acc``), same unit.
+    """
     return -_vec3(acc, "acc")
 
 
@@ -214,13 +304,34 @@ def gyro_to_body_rates(gyr) -> np.ndarray:
 
     :math:`\dot\rho=\omega_x`, :math:`\dot\beta=-\omega_y` (positive nose-up),
     :math:`\dot\alpha=\omega_z`. Units are kept (pass rad/s for radians).
+
+    Parameters
+    ----------
+    gyr : array_like, shape (..., 3)
+        Sensor-frame angular velocity (ω_x, ω_y, ω_z), in rad/s or °/s (kept).
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., 3)
+        Roll, pitch and yaw speeds (ρ̇, β̇, α̇), in the unit of ``gyr``.
     """
     g = _vec3(gyr, "gyr")
     return np.stack([g[..., 0], -g[..., 1], g[..., 2]], axis=-1)
 
 
 def body_rates_to_gyro(rates) -> np.ndarray:
-    """Inverse of :func:`gyro_to_body_rates`: (ρ̇, β̇, α̇) → (ω_x, ω_y, ω_z)."""
+    """Inverse of :func:`gyro_to_body_rates`: (ρ̇, β̇, α̇) → (ω_x, ω_y, ω_z).
+
+    Parameters
+    ----------
+    rates : array_like, shape (..., 3)
+        Benhamou's roll, pitch and yaw speeds (ρ̇, β̇, α̇), in rad/s or °/s (kept).
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., 3)
+        Sensor-frame angular velocity (ω_x, ω_y, ω_z), in the unit of ``rates``.
+    """
     return gyro_to_body_rates(rates)
 
 
@@ -229,6 +340,20 @@ def angles_to_matrix(azimuth, elevation, bank) -> np.ndarray:
 
     Column k is body axis k (surge, sway, heave) in world coordinates; column 0 is
     :math:`[\theta\bullet\phi]`.
+
+    Parameters
+    ----------
+    azimuth : array_like
+        Azimuth θ in rad (heading of the surge axis, counter-clockwise from East).
+    elevation : array_like
+        Elevation φ in rad (positive nose up).
+    bank : array_like
+        Bank λ in rad (roll about the surge axis). The three angles broadcast.
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., 3, 3)
+        Body → world (ENU) rotation matrices ``C``.
     """
     return R3(azimuth) @ R2(elevation) @ R1(bank)
 
@@ -243,6 +368,20 @@ def angles_from_matrix(matrix, singular_tol: float = 1e-9) -> Orientation:
     θ and λ are then not separately defined; following Benhamou (§3, App. B) the
     pseudo-bank is λ = 0 and the pseudo-azimuth θ = θ' − π/2 with θ' the azimuth of
     the sway axis, which represents the same rotation exactly.
+
+    Parameters
+    ----------
+    matrix : array_like, shape (..., 3, 3)
+        Body → world rotation matrices (orthonormal within 1e-6, determinant +1).
+    singular_tol : float, optional
+        Threshold (≥ 0) on cos φ below which the configuration is treated as singular
+        (default 1e-9).
+
+    Returns
+    -------
+    Orientation
+        Named tuple ``(azimuth, elevation, bank)`` of arrays of shape (...), in rad:
+        azimuth θ and bank λ in (−π, π], elevation φ in [−π/2, π/2].
     """
     C = np.asarray(matrix, dtype=float)
     if C.shape[-2:] != (3, 3):
@@ -265,6 +404,20 @@ def angles_to_quaternion(azimuth, elevation, bank) -> np.ndarray:
     r"""Sensor(body)→world quaternions (w, x, y, z) of :math:`R_3(\theta)R_2(\phi)R_1(\lambda)`, w ≥ 0.
 
     Closed form :math:`q = q_z(\theta)\otimes q_y(-\phi)\otimes q_x(\lambda)`.
+
+    Parameters
+    ----------
+    azimuth : array_like
+        Azimuth θ in rad (heading of the surge axis, counter-clockwise from East).
+    elevation : array_like
+        Elevation φ in rad (positive nose up).
+    bank : array_like
+        Bank λ in rad (roll about the surge axis). The three angles broadcast.
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., 4)
+        Unit quaternions (w, x, y, z), w ≥ 0, rotating body (sensor) to world.
     """
     t, p, lam = np.broadcast_arrays(
         *(
@@ -284,7 +437,22 @@ def angles_to_quaternion(azimuth, elevation, bank) -> np.ndarray:
 
 
 def angles_from_quaternion(q, singular_tol: float = 1e-9) -> Orientation:
-    """Azimuth, elevation, bank of sensor(body)→world quaternions (see :func:`angles_from_matrix`)."""
+    """Azimuth, elevation, bank of sensor(body)→world quaternions (see :func:`angles_from_matrix`).
+
+    Parameters
+    ----------
+    q : array_like, shape (..., 4)
+        Unit body (sensor) → world quaternions (w, x, y, z), norm 1 within 1e-6.
+    singular_tol : float, optional
+        Threshold (≥ 0) on cos φ below which the configuration is treated as singular
+        (default 1e-9); see :func:`angles_from_matrix`.
+
+    Returns
+    -------
+    Orientation
+        Named tuple ``(azimuth, elevation, bank)`` of arrays of shape (...), in rad:
+        azimuth θ and bank λ in (−π, π], elevation φ in [−π/2, π/2].
+    """
     q = np.asarray(q, dtype=float)
     if q.ndim == 0 or q.shape[-1] != 4:
         raise ValueError(f"q must have a last dimension of size 4, got {q.shape}")
@@ -299,6 +467,24 @@ def acc_from_angles(
 
     Specific force (``"tiltlab"``): :math:`g\,C^\top e_z = g(\sin\phi, \cos\phi\sin\lambda, \cos\phi\cos\lambda)`;
     ``"benhamou"`` returns its negative.
+
+    Parameters
+    ----------
+    elevation : array_like
+        Elevation φ in rad (positive nose up).
+    bank : array_like
+        Bank λ in rad. ``elevation`` and ``bank`` broadcast.
+    g : float, optional
+        Magnitude of gravity (> 0) in the output unit: 1.0 (default) gives g units,
+        9.81 gives m/s².
+    convention : {"tiltlab", "benhamou"}, optional
+        Sign of the output: specific force (``"tiltlab"``, default, +g on the up axis)
+        or Benhamou's acceleration (−g on the up axis).
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., 3)
+        Accelerometer readings in body axes, in the unit of ``g``.
     """
     g = _v.positive(g, "g")
     convention = _convention(convention)
@@ -319,6 +505,21 @@ def geomagnetic_field(
     ``inclination`` is the dip angle, positive *downwards* (northern hemisphere),
     ``declination`` is positive East of true North:
     :math:`B(\cos I\sin D, \cos I\cos D, -\sin I)`.
+
+    Parameters
+    ----------
+    intensity : float, optional
+        Total field intensity (> 0), in the unit wanted for the output; default 48.0
+        (µT).
+    inclination : float, optional
+        Dip angle I in rad, positive downwards; default 64° (in rad).
+    declination : float, optional
+        Declination D in rad, positive East of true North; default 0.
+
+    Returns
+    -------
+    numpy.ndarray, shape (3,)
+        Field (East, North, Up) in the unit of ``intensity``.
     """
     intensity = _v.positive(intensity, "intensity")
     inclination = _v.finite(inclination, "inclination")
@@ -333,7 +534,25 @@ def geomagnetic_field(
 
 
 def mag_from_angles(azimuth, elevation, bank, field=None) -> np.ndarray:
-    """Magnetometer reading (field in body axes, :math:`C^T m_{ENU}`) for orientations θ, φ, λ, shape (..., 3)."""
+    """Magnetometer reading (field in body axes, :math:`C^T m_{ENU}`) for orientations θ, φ, λ, shape (..., 3).
+
+    Parameters
+    ----------
+    azimuth : array_like
+        Azimuth θ in rad (heading of the surge axis, counter-clockwise from East).
+    elevation : array_like
+        Elevation φ in rad (positive nose up).
+    bank : array_like
+        Bank λ in rad (roll about the surge axis). The three angles broadcast.
+    field : array_like, shape (3,), optional
+        Earth magnetic field in ENU world coordinates, any unit (kept); the default,
+        ``None``, is ``geomagnetic_field()`` (48 µT, dip 64°).
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., 3)
+        The field in body axes, in the unit of ``field``.
+    """
     m = geomagnetic_field() if field is None else _vec3(field, "field")
     C = angles_to_matrix(azimuth, elevation, bank)
     return np.einsum("...ji,j->...i", C, m)
@@ -352,6 +571,22 @@ def mounting_angles(
     :math:`\phi^*=\sin^{-1}(-a^*_U/\|\mathbf a^*\|)`, :math:`\lambda^*=\mathrm{atan2}(-a^*_V,-a^*_W)` (§1),
     with Benhamou's sign (converted from ``convention``). ``acc_rest`` may be a
     single vector or many (then average them first for a single mounting).
+
+    Parameters
+    ----------
+    acc_rest : array_like, shape (3,) or (..., 3)
+        Device-frame acceleration recorded with the animal at rest and level, in any
+        unit (g or m/s²); non-zero.
+    convention : {"tiltlab", "benhamou"}, optional
+        Sign convention of ``acc_rest``: specific force (``"tiltlab"``, default) or
+        Benhamou's acceleration.
+
+    Returns
+    -------
+    phi_star : numpy.ndarray, shape (...)
+        Mounting elevation φ* in rad, in [−π/2, π/2].
+    lambda_star : numpy.ndarray, shape (...)
+        Mounting bank λ* in rad, in (−π, π].
     """
     a = _as_benhamou(acc_rest, convention, "acc_rest")
     return _elev_bank(_nonzero(a, "acc_rest"))
@@ -364,7 +599,22 @@ def _elev_bank(A):
 
 
 def mounting_matrix(phi_star, lambda_star, dtheta=0.0) -> np.ndarray:
-    r"""Device→body matrix :math:`R_3(\Delta\theta)R_2(\phi^*)R_1(\lambda^*)` (App. A; Δθ = 0 gives Eq. 1)."""
+    r"""Device→body matrix :math:`R_3(\Delta\theta)R_2(\phi^*)R_1(\lambda^*)` (App. A; Δθ = 0 gives Eq. 1).
+
+    Parameters
+    ----------
+    phi_star : array_like
+        Mounting elevation φ* in rad.
+    lambda_star : array_like
+        Mounting bank λ* in rad.
+    dtheta : array_like, optional
+        Mounting azimuth offset Δθ in rad (default 0, Eq. 1). The angles broadcast.
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., 3, 3)
+        Device → body rotation matrices.
+    """
     return R3(dtheta) @ R2(phi_star) @ R1(lambda_star)
 
 
@@ -377,6 +627,26 @@ def device_to_body(
     field, and tiltlab gyroscope vectors ω, which are ordinary vectors. If
     ``rates=True`` the columns are Benhamou's (ρ̇, β̇, α̇); the pitch-rate sign is
     flipped before and after the rotation (App. A: :math:`B_V=-\dot\beta`, :math:`D_V=-\dot\beta^d`).
+
+    Parameters
+    ----------
+    vectors : array_like, shape (..., 3)
+        Vectors in device coordinates, in any unit (kept).
+    phi_star : array_like
+        Mounting elevation φ* in rad (see :func:`mounting_angles`).
+    lambda_star : array_like
+        Mounting bank λ* in rad.
+    dtheta : array_like, optional
+        Mounting azimuth offset Δθ in rad (default 0).
+    rates : bool, optional
+        If True, ``vectors`` are Benhamou's (ρ̇, β̇, α̇) rates rather than ordinary
+        vectors (default False).
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., 3)
+        The vectors in body coordinates (surge, sway, heave), in the unit of
+        ``vectors``.
     """
     D = _vec3(vectors, "vectors")
     if rates:
@@ -399,6 +669,23 @@ def device_to_body_eq1(
     with a* in Benhamou's sign (converted from ``convention``). Identical to
     :func:`device_to_body` with :func:`mounting_angles`. Requires s > 0 (device not
     mounted vertically).
+
+    Parameters
+    ----------
+    vectors : array_like, shape (..., 3)
+        Vectors D in device coordinates, in any unit (kept).
+    acc_rest : array_like, shape (3,) or (..., 3)
+        Device-frame acceleration a* recorded at rest and level, in any unit, with a
+        non-zero sway/heave part; broadcasts with ``vectors``.
+    convention : {"tiltlab", "benhamou"}, optional
+        Sign convention of ``acc_rest``: specific force (``"tiltlab"``, default) or
+        Benhamou's acceleration.
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., 3)
+        The vectors B in body coordinates (surge, sway, heave), in the unit of
+        ``vectors``.
     """
     D = _vec3(vectors, "vectors")
     a = _as_benhamou(acc_rest, convention, "acc_rest")
@@ -426,6 +713,16 @@ def fibonacci_lattice(n: int = 5000) -> np.ndarray:
 
     Point :math:`i = 0,\dots,n-1` has :math:`z_i = 1 - (2i+1)/n` (equal-area latitude
     bands) and longitude :math:`2\pi i/\Phi` with the golden ratio :math:`\Phi` [3]_.
+
+    Parameters
+    ----------
+    n : int, optional
+        Number of points (≥ 1); default 5000.
+
+    Returns
+    -------
+    numpy.ndarray, shape (n, 3)
+        Unit vectors (dimensionless), from near the north pole (z ≈ 1) southwards.
     """
     if isinstance(n, bool) or int(n) != n or n < 1:
         raise ValueError(f"n must be a positive integer, got {n!r}")
@@ -442,6 +739,19 @@ def stage_angles(g) -> tuple[np.ndarray, np.ndarray]:
     With the stage :math:`R = R_y(\beta) R_x(\gamma)`, the tilt is
     :math:`g = R^\top e_z = (-\sin\beta, \sin\gamma\cos\beta, \cos\gamma\cos\beta)`,
     so :math:`\beta = -\arcsin g_x` and :math:`\gamma = \operatorname{atan2}(g_y, g_z)`.
+
+    Parameters
+    ----------
+    g : array_like, shape (..., 3)
+        Target gravity-up directions in the sensor frame; non-zero, need not be unit
+        (any unit).
+
+    Returns
+    -------
+    pitch : numpy.ndarray, shape (...)
+        Stage pitch β in rad, in [−π/2, π/2].
+    roll : numpy.ndarray, shape (...)
+        Stage roll γ in rad, in (−π, π].
     """
     g = _nonzero(_vec3(g, "g"), "g")
     g = g / np.linalg.norm(g, axis=-1, keepdims=True)
@@ -452,7 +762,20 @@ def stage_angles(g) -> tuple[np.ndarray, np.ndarray]:
 
 
 def stage_quaternion(pitch, roll) -> np.ndarray:
-    """Orientation ``R_y(pitch) R_x(roll)`` (sensor → world) of the two-axis stage."""
+    """Orientation ``R_y(pitch) R_x(roll)`` (sensor → world) of the two-axis stage.
+
+    Parameters
+    ----------
+    pitch : array_like
+        Stage pitch β in rad (rotation about y).
+    roll : array_like
+        Stage roll γ in rad (rotation about x). ``pitch`` and ``roll`` broadcast.
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., 4)
+        Unit sensor → world quaternions (w, x, y, z).
+    """
     pitch, roll = np.broadcast_arrays(_angle(pitch, "pitch"), _angle(roll, "roll"))
     z = np.zeros_like(pitch)
     return _quat.mul(
@@ -472,6 +795,18 @@ def head_frame_from_markers(m1, m2, m3) -> np.ndarray:
 
     :math:`h_y = (m_1 - m_2)/\|\cdot\|`, :math:`h_z = (m_3 - m_2) \times h_y / \|\cdot\|`,
     :math:`h_x = h_y \times h_z`.
+
+    Parameters
+    ----------
+    m1, m2, m3 : array_like, shape (..., 3)
+        Positions of markers 1, 2 and 3 in mocap (world) coordinates, in any length
+        unit; not coincident or collinear. They broadcast; NaN (missing marker)
+        propagates.
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., 3, 3)
+        Head → world rotation matrices with columns ``h_x``, ``h_y``, ``h_z``.
     """
     m1, m2, m3 = (_vec3(v, n) for v, n in ((m1, "m1"), (m2, "m2"), (m3, "m3")))
     v21, v23 = m1 - m2, m3 - m2

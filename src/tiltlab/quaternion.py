@@ -382,7 +382,19 @@ def check_rotation(m: np.ndarray, name: str = "m", atol: float = 1e-6) -> None:
 
 
 def identity(n: int | None = None) -> np.ndarray:
-    """The identity quaternion (1, 0, 0, 0), or ``n`` of them."""
+    """The identity quaternion (1, 0, 0, 0), or ``n`` of them.
+
+    Parameters
+    ----------
+    n : int, optional
+        Number of identity quaternions (≥ 0). The default, ``None``, returns a single
+        quaternion of shape (4,).
+
+    Returns
+    -------
+    numpy.ndarray, shape (4,) or (n, 4)
+        The identity quaternion (1, 0, 0, 0) (no rotation), once or ``n`` times.
+    """
     if n is None:
         return np.array([1.0, 0.0, 0.0, 0.0])
     n = _v.integer(n, "n", minimum=0)
@@ -395,6 +407,19 @@ def mul(p, q) -> np.ndarray:
     r"""Hamilton product :math:`p \otimes q` (broadcast over leading dimensions).
 
     With sensor → world quaternions, ``mul(p, q)`` applies ``q`` first, then ``p``.
+
+    Parameters
+    ----------
+    p : array_like, shape (..., 4)
+        Left factor (w, x, y, z), applied second.
+    q : array_like, shape (..., 4)
+        Right factor (w, x, y, z), applied first. The leading dimensions of ``p`` and
+        ``q`` broadcast; neither needs to be unit; NaN (a missing sample) propagates.
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., 4)
+        The Hamilton products ``p ⊗ q`` (w, x, y, z), with the broadcast shape.
     """
     p, q = _real(p, "p"), _real(q, "q")
     _check_last(p, 4, "p")
@@ -407,7 +432,18 @@ def mul(p, q) -> np.ndarray:
 
 
 def conj(q) -> np.ndarray:
-    """Conjugate (w, −x, −y, −z): the inverse of a unit quaternion."""
+    """Conjugate (w, −x, −y, −z): the inverse of a unit quaternion.
+
+    Parameters
+    ----------
+    q : array_like, shape (..., 4)
+        Quaternions (w, x, y, z); not modified.
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., 4)
+        The conjugates (w, −x, −y, −z), a new array.
+    """
     q = np.array(_real(q, "q"), dtype=float)
     _check_last(q, 4, "q")
     q[..., 1:] *= -1.0
@@ -415,7 +451,18 @@ def conj(q) -> np.ndarray:
 
 
 def inv(q) -> np.ndarray:
-    """Inverse :math:`q^* / \\|q\\|^2` (equals :func:`conj` for unit quaternions)."""
+    """Inverse :math:`q^* / \\|q\\|^2` (equals :func:`conj` for unit quaternions).
+
+    Parameters
+    ----------
+    q : array_like, shape (..., 4)
+        Finite, non-zero quaternions (w, x, y, z); they need not be unit.
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., 4)
+        The inverses (w, x, y, z), such that ``mul(q, inv(q))`` is the identity.
+    """
     q = _real(q, "q")
     _check_last(q, 4, "q")
     _no_zero(_no_inf(q, "q"), "q")
@@ -423,12 +470,34 @@ def inv(q) -> np.ndarray:
 
 
 def norm(q) -> np.ndarray:
-    """Euclidean norm over the last axis."""
+    """Euclidean norm over the last axis.
+
+    Parameters
+    ----------
+    q : array_like, shape (..., 4)
+        Quaternions (w, x, y, z) (or any vectors on the last axis).
+
+    Returns
+    -------
+    numpy.ndarray, shape (...)
+        The Euclidean norms (1 for unit quaternions).
+    """
     return np.linalg.norm(_real(q, "q"), axis=-1)
 
 
 def normalize(q) -> np.ndarray:
-    """Unit quaternions; a zero quaternion is an error."""
+    """Unit quaternions; a zero quaternion is an error.
+
+    Parameters
+    ----------
+    q : array_like, shape (..., 4)
+        Finite, non-zero quaternions (w, x, y, z); NaN (a missing sample) propagates.
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., 4)
+        ``q`` divided by its norm: unit quaternions of the same rotations.
+    """
     q = _no_inf(_real(q, "q"), "q")
     _check_last(q, 4, "q")
     n = np.linalg.norm(q, axis=-1, keepdims=True)
@@ -440,18 +509,60 @@ def normalize(q) -> np.ndarray:
 
 
 def canonical(q) -> np.ndarray:
-    """The representative with w ≥ 0 (q and −q are the same rotation)."""
+    """The representative with w ≥ 0 (q and −q are the same rotation).
+
+    Parameters
+    ----------
+    q : array_like, shape (..., 4)
+        Quaternions (w, x, y, z).
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., 4)
+        ``q`` where w ≥ 0, else ``−q``: the same rotations, with a non-negative scalar
+        part.
+    """
     q = _real(q, "q")
     return np.where(q[..., :1] < 0, -q, q)
 
 
 def rotate(q, v) -> np.ndarray:
-    r"""Rotate sensor-frame vectors to the world frame: :math:`R(q)\,v`."""
+    r"""Rotate sensor-frame vectors to the world frame: :math:`R(q)\,v`.
+
+    Parameters
+    ----------
+    q : array_like, shape (..., 4)
+        Unit sensor → world quaternions (w, x, y, z); not renormalised.
+    v : array_like, shape (..., 3)
+        Vectors in sensor coordinates, in any unit (kept). The leading dimensions of
+        ``q`` and ``v`` broadcast.
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., 3)
+        The same vectors in world coordinates, in the unit of ``v``, with the broadcast
+        leading shape.
+    """
     return _rotate(q, v, False)
 
 
 def rotate_inverse(q, v) -> np.ndarray:
-    r"""Rotate world-frame vectors to the sensor frame: :math:`R(q)^\top v`."""
+    r"""Rotate world-frame vectors to the sensor frame: :math:`R(q)^\top v`.
+
+    Parameters
+    ----------
+    q : array_like, shape (..., 4)
+        Unit sensor → world quaternions (w, x, y, z); not renormalised.
+    v : array_like, shape (..., 3)
+        Vectors in world coordinates, in any unit (kept). The leading dimensions of
+        ``q`` and ``v`` broadcast.
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., 3)
+        The same vectors in sensor coordinates, in the unit of ``v``, with the broadcast
+        leading shape.
+    """
     return _rotate(q, v, True)
 
 
@@ -470,7 +581,18 @@ def _rotate(q, v, inverse: bool) -> np.ndarray:
 
 
 def to_matrix(q) -> np.ndarray:
-    """Rotation matrices R(q), shape (..., 3, 3), mapping sensor to world coordinates."""
+    """Rotation matrices R(q), shape (..., 3, 3), mapping sensor to world coordinates.
+
+    Parameters
+    ----------
+    q : array_like, shape (..., 4)
+        Unit sensor → world quaternions (w, x, y, z), norm 1 within 1e-6.
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., 3, 3)
+        Rotation matrices; ``R @ v_s`` gives world coordinates of a sensor vector.
+    """
     q = _real(q, "q")
     _check_last(q, 4, "q")
     check_unit(q, "q")
@@ -480,7 +602,19 @@ def to_matrix(q) -> np.ndarray:
 
 
 def from_matrix(m) -> np.ndarray:
-    """Unit quaternions (w ≥ 0) from rotation matrices (Shepperd's method [2]_)."""
+    """Unit quaternions (w ≥ 0) from rotation matrices (Shepperd's method [2]_).
+
+    Parameters
+    ----------
+    m : array_like, shape (..., 3, 3)
+        Rotation matrices (orthonormal within 1e-6, determinant +1) mapping sensor to
+        world coordinates.
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., 4)
+        Unit quaternions (w, x, y, z) with w ≥ 0.
+    """
     m = _real(m, "m")
     if m.shape[-2:] != (3, 3):
         raise ValueError(f"m must have shape (..., 3, 3), got {m.shape}")
@@ -491,7 +625,18 @@ def from_matrix(m) -> np.ndarray:
 
 
 def to_rotvec(q) -> np.ndarray:
-    """Rotation vectors (axis × angle, angle in [0, π]) of unit quaternions."""
+    """Rotation vectors (axis × angle, angle in [0, π]) of unit quaternions.
+
+    Parameters
+    ----------
+    q : array_like, shape (..., 4)
+        Unit quaternions (w, x, y, z), norm 1 within 1e-6.
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., 3)
+        Rotation vectors: unit axis times angle (rad), norm in [0, π].
+    """
     q = _real(q, "q")
     _check_last(q, 4, "q")
     check_unit(q, "q")
@@ -501,7 +646,18 @@ def to_rotvec(q) -> np.ndarray:
 
 
 def from_rotvec(r) -> np.ndarray:
-    r"""Unit quaternions :math:`(\cos\tfrac{\theta}{2}, \sin\tfrac{\theta}{2}\,\hat r)` from rotation vectors."""
+    r"""Unit quaternions :math:`(\cos\tfrac{\theta}{2}, \sin\tfrac{\theta}{2}\,\hat r)` from rotation vectors.
+
+    Parameters
+    ----------
+    r : array_like, shape (..., 3)
+        Rotation vectors: axis times angle θ (rad); finite.
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., 4)
+        Unit quaternions (w, x, y, z) of the same rotations.
+    """
     r = _no_inf(_real(r, "r"), "r")
     _check_last(r, 3, "r")
     with np.errstate(over="ignore"):
@@ -519,12 +675,34 @@ def exp(v) -> np.ndarray:
     r"""Exponential of pure quaternions :math:`(0, v)`: :math:`\exp(v) = (\cos\|v\|, \sin\|v\|\,\hat v)`.
 
     Note ``exp(r / 2) == from_rotvec(r)``.
+
+    Parameters
+    ----------
+    v : array_like, shape (..., 3)
+        Vector parts of pure quaternions (rad: half the rotation vector); finite.
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., 4)
+        Unit quaternions (w, x, y, z), a rotation by ``2‖v‖`` rad about ``v``.
     """
     return from_rotvec(2.0 * _real(v, "v"))
 
 
 def log(q) -> np.ndarray:
-    """Logarithm of unit quaternions as the vector part (``to_rotvec(q) / 2``)."""
+    """Logarithm of unit quaternions as the vector part (``to_rotvec(q) / 2``).
+
+    Parameters
+    ----------
+    q : array_like, shape (..., 4)
+        Unit quaternions (w, x, y, z), norm 1 within 1e-6.
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., 3)
+        Vector parts of the logarithms: axis times half the rotation angle (rad), norm
+        in [0, π/2].
+    """
     return 0.5 * to_rotvec(q)
 
 
@@ -533,6 +711,17 @@ def gravity(q) -> np.ndarray:
 
     For a sensor at rest, this is the direction of the accelerometer reading
     (the specific force points up).
+
+    Parameters
+    ----------
+    q : array_like, shape (..., 4)
+        Unit sensor → world quaternions (w, x, y, z); finite, non-zero.
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., 3)
+        Gravity-up directions in sensor coordinates (dimensionless unit vectors for
+        unit ``q``).
     """
     q = _real(q, "q")
     _check_last(q, 4, "q")
@@ -543,7 +732,19 @@ def gravity(q) -> np.ndarray:
 
 
 def angle_between(u, v) -> np.ndarray:
-    """Angle (rad) between vectors, computed as atan2(‖u×v‖, u·v) (accurate near 0 and π)."""
+    """Angle (rad) between vectors, computed as atan2(‖u×v‖, u·v) (accurate near 0 and π).
+
+    Parameters
+    ----------
+    u, v : array_like, shape (..., 3)
+        Finite, non-zero vectors (any unit, need not be unit vectors); the leading
+        dimensions broadcast.
+
+    Returns
+    -------
+    numpy.ndarray, shape (...)
+        Angles in rad, in [0, π].
+    """
     u, v = _real(u, "u"), _real(v, "v")
     _check_last(u, 3, "u")
     _check_last(v, 3, "v")
@@ -562,7 +763,21 @@ def angle_between(u, v) -> np.ndarray:
 
 
 def error_quaternion(q_est, q_ref) -> np.ndarray:
-    r"""Earth-frame error quaternion :math:`e = q_{est} \otimes q_{ref}^{-1}` (BROAD's definition [3]_)."""
+    r"""Earth-frame error quaternion :math:`e = q_{est} \otimes q_{ref}^{-1}` (BROAD's definition [3]_).
+
+    Parameters
+    ----------
+    q_est : array_like, shape (..., 4)
+        Estimated sensor → world unit quaternions (w, x, y, z).
+    q_ref : array_like, shape (..., 4)
+        Reference (ground-truth) sensor → world unit quaternions (w, x, y, z); the
+        leading dimensions of ``q_est`` and ``q_ref`` broadcast.
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., 4)
+        Earth-frame error quaternions ``e`` (w, x, y, z).
+    """
     return mul(q_est, conj(q_ref))
 
 
@@ -570,6 +785,19 @@ def error_angles(q_est, q_ref) -> np.ndarray:
     r"""Total, heading and tilt errors (rad) in one pass, stacked on the last axis (..., 3).
 
     See :func:`total_error`, :func:`heading_error` and :func:`tilt_error`.
+
+    Parameters
+    ----------
+    q_est : array_like, shape (..., 4)
+        Estimated sensor → world quaternions (w, x, y, z); finite, non-zero.
+    q_ref : array_like, shape (..., 4)
+        Reference (ground-truth) sensor → world quaternions (w, x, y, z); the leading
+        dimensions of ``q_est`` and ``q_ref`` broadcast.
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., 3)
+        Columns: total, heading and tilt errors, each in rad, in [0, π].
     """
     p, q = _real(q_est, "q_est"), _real(q_ref, "q_ref")
     _check_last(p, 4, "q_est")
@@ -583,13 +811,41 @@ def error_angles(q_est, q_ref) -> np.ndarray:
 
 
 def total_error(q_est, q_ref) -> np.ndarray:
-    r"""Total orientation error (rad): the angle of :math:`e = q_{est} \otimes q_{ref}^{-1}`, in [0, π]."""
+    r"""Total orientation error (rad): the angle of :math:`e = q_{est} \otimes q_{ref}^{-1}`, in [0, π].
+
+    Parameters
+    ----------
+    q_est : array_like, shape (..., 4)
+        Estimated sensor → world quaternions (w, x, y, z); finite, non-zero.
+    q_ref : array_like, shape (..., 4)
+        Reference (ground-truth) sensor → world quaternions (w, x, y, z); the leading
+        dimensions of ``q_est`` and ``q_ref`` broadcast.
+
+    Returns
+    -------
+    numpy.ndarray, shape (...)
+        Total errors in rad, in [0, π].
+    """
     return error_angles(q_est, q_ref)[..., 0]
 
 
 def heading_error(q_est, q_ref) -> np.ndarray:
     r"""Heading error (rad): the angle of the rotation about world z in the heading–inclination
-    decomposition of the Earth-frame error, :math:`2\,\mathrm{atan2}(|e_z|, |e_w|)`, in [0, π]."""
+    decomposition of the Earth-frame error, :math:`2\,\mathrm{atan2}(|e_z|, |e_w|)`, in [0, π].
+
+    Parameters
+    ----------
+    q_est : array_like, shape (..., 4)
+        Estimated sensor → world quaternions (w, x, y, z); finite, non-zero.
+    q_ref : array_like, shape (..., 4)
+        Reference (ground-truth) sensor → world quaternions (w, x, y, z); the leading
+        dimensions of ``q_est`` and ``q_ref`` broadcast.
+
+    Returns
+    -------
+    numpy.ndarray, shape (...)
+        Heading errors in rad, in [0, π].
+    """
     return error_angles(q_est, q_ref)[..., 1]
 
 
@@ -600,6 +856,19 @@ def tilt_error(q_est, q_ref) -> np.ndarray:
     ``angle_between(gravity(q_est), gravity(q_ref))``, and to BROAD's inclination
     error [3]_. Computed as :math:`2\,\mathrm{atan2}(\sqrt{e_x^2+e_y^2}, \sqrt{e_w^2+e_z^2})`
     for accuracy near zero.
+
+    Parameters
+    ----------
+    q_est : array_like, shape (..., 4)
+        Estimated sensor → world quaternions (w, x, y, z); finite, non-zero.
+    q_ref : array_like, shape (..., 4)
+        Reference (ground-truth) sensor → world quaternions (w, x, y, z); the leading
+        dimensions of ``q_est`` and ``q_ref`` broadcast.
+
+    Returns
+    -------
+    numpy.ndarray, shape (...)
+        Tilt (inclination) errors in rad, in [0, π].
     """
     return error_angles(q_est, q_ref)[..., 2]
 
@@ -723,12 +992,33 @@ def from_scipy(rot) -> np.ndarray:
     """Scalar-first quaternions from a :class:`scipy.spatial.transform.Rotation`.
 
     scipy's ``as_quat()`` is scalar-last; this converts explicitly.
+
+    Parameters
+    ----------
+    rot : scipy.spatial.transform.Rotation
+        One rotation or a stack of ``N`` rotations.
+
+    Returns
+    -------
+    numpy.ndarray, shape (4,) or (N, 4)
+        Unit quaternions (w, x, y, z).
     """
     return np.asarray(rot.as_quat(scalar_first=True))
 
 
 def to_scipy(q):
-    """A :class:`scipy.spatial.transform.Rotation` from scalar-first quaternions."""
+    """A :class:`scipy.spatial.transform.Rotation` from scalar-first quaternions.
+
+    Parameters
+    ----------
+    q : array_like, shape (4,) or (N, 4)
+        Scalar-first quaternions (w, x, y, z); scipy normalises them.
+
+    Returns
+    -------
+    scipy.spatial.transform.Rotation
+        One rotation, or a stack of ``N``, representing ``q``.
+    """
     from scipy.spatial.transform import Rotation
 
     return Rotation.from_quat(np.asarray(q, float), scalar_first=True)
@@ -737,7 +1027,21 @@ def to_scipy(q):
 def random_quaternions(
     n: int, rng: np.random.Generator | int | None = None
 ) -> np.ndarray:
-    """``n`` uniformly distributed unit quaternions (Shoemake's method), w ≥ 0."""
+    """``n`` uniformly distributed unit quaternions (Shoemake's method), w ≥ 0.
+
+    Parameters
+    ----------
+    n : int
+        Number of quaternions (≥ 0).
+    rng : numpy.random.Generator or int or None, optional
+        Random generator, or a seed for :func:`numpy.random.default_rng`; ``None``
+        (default) draws fresh entropy (not reproducible).
+
+    Returns
+    -------
+    numpy.ndarray, shape (n, 4)
+        Unit quaternions (w, x, y, z) with w ≥ 0, uniform over rotations.
+    """
     n = _v.integer(n, "n", minimum=0)
     rng = np.random.default_rng(rng)
     u1, u2, u3 = rng.random((3, n))
