@@ -145,7 +145,25 @@ def parse_axes(spec: Sequence[str], where: str = "axes") -> np.ndarray:
 
 
 def check_labels(labels: Sequence[str], where: str = "axis_labels") -> list[str]:
-    """Three axis labels as a list of str."""
+    """Three axis labels as a list of str.
+
+    Parameters
+    ----------
+    labels : sequence of 3 str
+        Names of the x, y and z axes, e.g. ``["forward", "left", "up"]``.
+    where : str
+        Name used in messages.
+
+    Returns
+    -------
+    list of str
+        The three labels, converted to str.
+
+    Raises
+    ------
+    ValueError
+        If ``labels`` is not a sequence of three items.
+    """
     if isinstance(labels, str) or not isinstance(labels, Sequence) or len(labels) != 3:
         raise ValueError(
             f"{where} must be three names, e.g. ['forward', 'left', 'up'], got {labels!r}"
@@ -265,7 +283,18 @@ def _describe(m: np.ndarray) -> str:
 
 def axis_labels(obj: Any) -> list[str]:
     """The axis labels of a Recording or labelled DataArray (``attrs['axis_labels']``),
-    or ``["x", "y", "z"]`` when none are recorded."""
+    or ``["x", "y", "z"]`` when none are recorded.
+
+    Parameters
+    ----------
+    obj : object
+        A Recording (xarray.Dataset), a DataArray or anything with ``attrs``.
+
+    Returns
+    -------
+    list of str
+        Three labels (x, y, z axes).
+    """
     attrs = getattr(obj, "attrs", {}) or {}
     labels = attrs.get("axis_labels")
     if labels is None or len(labels) != 3:

@@ -87,7 +87,23 @@ def registry() -> dict[str, dict[str, str]]:
 
 
 def citation(dataset: str) -> str:
-    """Citation of a registered data set (``"broad"`` or ``"fayat2021"``)."""
+    """Citation of a registered data set (``"broad"`` or ``"fayat2021"``).
+
+    Parameters
+    ----------
+    dataset : str
+        Data set key, ``"broad"`` or ``"fayat2021"``.
+
+    Returns
+    -------
+    str
+        The citation text.
+
+    Raises
+    ------
+    DataError
+        If the data set is unknown.
+    """
     meta = json.loads(
         (resources.files("tiltlab") / "_registry" / "datasets.json").read_text()
     )
@@ -135,6 +151,18 @@ def verify(path: str | os.PathLike, name: str) -> Path:
 def fetch(name: str, *, progressbar: bool = False) -> Path:
     """Local path of registered file ``name`` (e.g. ``"broad/02_undisturbed_slow_rotation_B.hdf5"``),
     checksum verified.
+
+    Parameters
+    ----------
+    name : str
+        A registry file name (a key of :func:`registry`).
+    progressbar : bool
+        Show a download progress bar (default False).
+
+    Returns
+    -------
+    pathlib.Path
+        Path of the verified local file (in the mirror or the cache).
 
     Raises
     ------
@@ -260,6 +288,21 @@ def load_broad_trial(trial: int | str) -> xr.Dataset:
     Returns a validated Recording with ``acc`` (m/s²), ``gyr`` (rad/s), ``mag`` (µT),
     ``q_ref`` (optical ground truth, NaN where tracking was lost), ``movement`` and
     ``opt_pos``; ``fs`` = 285.714… Hz.
+
+    Parameters
+    ----------
+    trial : int or str
+        A registered BROAD trial number (see :func:`broad_trials`) or its file stem.
+
+    Returns
+    -------
+    xarray.Dataset
+        The validated Recording.
+
+    Raises
+    ------
+    DataError
+        If the trial is not registered or its file cannot be fetched.
     """
     trials = broad_trials()
     if isinstance(trial, str):

@@ -33,7 +33,24 @@ __all__ = ["lowpass", "moving_mean", "moving_std", "still_mask", "window_samples
 def window_samples(
     window_s: float, fs: float, *, minimum: int = 1, name: str = "window_s"
 ) -> int:
-    """Number of samples in a window of ``window_s`` seconds at ``fs`` (rounded, ≥ ``minimum``)."""
+    """Number of samples in a window of ``window_s`` seconds at ``fs`` (rounded, ≥ ``minimum``).
+
+    Parameters
+    ----------
+    window_s : float
+        Window duration (s), positive.
+    fs : float
+        Sampling rate (Hz).
+    minimum : int
+        Smallest number of samples returned (≥ 1; default 1).
+    name : str
+        Name of ``window_s`` in error messages.
+
+    Returns
+    -------
+    int
+        ``max(round(window_s * fs), minimum)``.
+    """
     window_s = _v.positive(window_s, name)
     fs = _v.check_fs(fs)
     minimum = _v.integer(minimum, "minimum", minimum=1)
@@ -89,7 +106,20 @@ def lowpass(
 
 
 def moving_mean(x, n: int) -> np.ndarray:
-    """Centred running mean over ``n`` samples along the first axis (``nearest`` edges)."""
+    """Centred running mean over ``n`` samples along the first axis (``nearest`` edges).
+
+    Parameters
+    ----------
+    x : array_like, shape (N, ...)
+        Samples (time first).
+    n : int
+        Window length (samples, ≥ 1).
+
+    Returns
+    -------
+    numpy.ndarray
+        A new array of the shape of ``x``.
+    """
     n = _v.integer(n, "n", minimum=1)
     x = _v.vectors(x, "x", width=None, ndim=None)
     if x.ndim == 0:
@@ -102,6 +132,18 @@ def moving_std(x, n: int) -> np.ndarray:
 
     :math:`\sqrt{\max(\overline{x^2} - \bar x^2, 0)}` (clipped: the running mean of tiny
     squares can round below the squared mean).
+
+    Parameters
+    ----------
+    x : array_like, shape (N,)
+        A 1-D series.
+    n : int
+        Window length (samples, ≥ 1).
+
+    Returns
+    -------
+    numpy.ndarray, shape (N,)
+        The running standard deviation (population, ``ddof=0``), in the unit of ``x``.
     """
     x = _v.vectors(x, "x", width=None, ndim=1)
     m1 = moving_mean(x, n)

@@ -18,6 +18,21 @@ def mask_to_intervals(mask, *, min_length: int = 1, merge_gap: int = 0) -> np.nd
 
     Runs separated by at most ``merge_gap`` False samples are merged first, then runs
     shorter than ``min_length`` samples are dropped.
+
+    Parameters
+    ----------
+    mask : array_like of bool, shape (N,)
+        The mask (booleans or 0/1 values).
+    min_length : int
+        Shortest run kept (samples; default 1, every run).
+    merge_gap : int
+        Longest run of False samples bridged between two True runs (samples; default
+        0, no merging).
+
+    Returns
+    -------
+    numpy.ndarray of int64, shape (k, 2)
+        ``[start, stop)`` sample indices of the runs, in order.
     """
     raw = np.asarray(mask)
     if raw.ndim != 1:
@@ -48,7 +63,19 @@ def mask_to_intervals(mask, *, min_length: int = 1, merge_gap: int = 0) -> np.nd
 
 
 def intervals_to_mask(intervals, n: int) -> np.ndarray:
-    """Boolean mask of length ``n`` that is True inside the ``[start, stop)`` intervals."""
+    """Boolean mask of length ``n`` that is True inside the ``[start, stop)`` intervals.
+
+    Parameters
+    ----------
+    intervals : array_like of int, shape (k, 2)
+        ``[start, stop)`` sample indices, ``0 <= start < stop <= n``; they may overlap.
+    n : int
+        Length of the mask (samples).
+
+    Returns
+    -------
+    numpy.ndarray of bool, shape (n,)
+    """
     n = _v.integer(n, "n", minimum=0)
     raw = np.asarray(intervals)
     if raw.dtype.kind not in "iub":
@@ -69,6 +96,18 @@ def samples_below(duration_s: float, fs: float) -> int:
 
     Used to turn "gaps shorter than 0.1 s are merged" into ``merge_gap`` for
     :func:`mask_to_intervals`: ``ceil(duration_s·fs) − 1``.
+
+    Parameters
+    ----------
+    duration_s : float
+        Duration (s), non-negative.
+    fs : float
+        Sampling rate (Hz).
+
+    Returns
+    -------
+    int
+        ``max(ceil(duration_s·fs) − 1, 0)`` samples.
     """
     duration_s = _v.nonnegative(duration_s, "duration_s")
     fs = _v.check_fs(fs)

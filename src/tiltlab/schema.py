@@ -566,6 +566,26 @@ def to_units(ds: xr.Dataset, **targets: str) -> xr.Dataset:
     Attributes are kept and each converted variable's ``units`` attribute is updated, and
     its ``range`` (full scale) converted. The copy is deep: it shares no memory with
     ``ds``.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A Recording whose variables carry a ``units`` attribute.
+    **targets : str
+        Variable name → target unit (any accepted spelling, see
+        :func:`tiltlab.units.normalise_unit`).
+
+    Returns
+    -------
+    xarray.Dataset
+        The converted deep copy.
+
+    Raises
+    ------
+    RecordingError
+        If a named variable is missing or has no ``units`` attribute.
+    tiltlab.units.UnitsError
+        If a conversion is impossible.
     """
     out = ds.copy(deep=True)
     for name, dst in targets.items():

@@ -92,6 +92,17 @@ class UnitsError(ValueError):
 def normalise_unit(unit: str) -> str:
     """Return the canonical spelling of ``unit``.
 
+    Parameters
+    ----------
+    unit : str
+        A unit spelling, canonical or an alias (case-insensitive, surrounding spaces
+        ignored), e.g. ``"m/s2"``, ``"°/s"``, ``"dps"``.
+
+    Returns
+    -------
+    str
+        The canonical spelling, one of :data:`UNITS`.
+
     Raises
     ------
     UnitsError
@@ -120,6 +131,24 @@ def conversion_factor(src: str, dst: str) -> float:
     """Multiplicative factor converting values in ``src`` units to ``dst`` units.
 
     Temperatures (an affine conversion) and arbitrary units are refused.
+
+    Parameters
+    ----------
+    src, dst : str
+        Source and destination units (any accepted spelling); both must measure the same
+        quantity.
+
+    Returns
+    -------
+    float
+        The factor ``f`` such that ``value_dst = f * value_src`` (``1.0`` if the units
+        are the same).
+
+    Raises
+    ------
+    UnitsError
+        If a unit is unknown, the units measure different quantities, or their
+        conversion is not multiplicative (temperatures, arbitrary units).
     """
     s, d = normalise_unit(src), normalise_unit(dst)
     if s == d:
@@ -134,15 +163,54 @@ def conversion_factor(src: str, dst: str) -> float:
 
 
 def convert(values, src: str, dst: str) -> np.ndarray:
-    """Return ``values`` (array-like) converted from ``src`` to ``dst`` units (a new array)."""
+    """Return ``values`` (array-like) converted from ``src`` to ``dst`` units (a new array).
+
+    Parameters
+    ----------
+    values : array_like
+        Values in ``src`` units, any shape.
+    src, dst : str
+        Source and destination units (see :func:`conversion_factor`).
+
+    Returns
+    -------
+    numpy.ndarray of float
+        A new array of the shape of ``values``, in ``dst`` units.
+    """
     return np.asarray(values, dtype=float) * conversion_factor(src, dst)
 
 
 def acc_to_g(values, units: str) -> np.ndarray:
-    """Acceleration in g from ``units`` ('g' or 'm/s^2')."""
+    """Acceleration in g from ``units`` ('g' or 'm/s^2').
+
+    Parameters
+    ----------
+    values : array_like
+        Accelerations, any shape (typically (N, 3)).
+    units : str
+        Units of ``values``: ``"g"`` or ``"m/s^2"`` (or an alias).
+
+    Returns
+    -------
+    numpy.ndarray of float
+        A new array of the shape of ``values``, in g (1 g = 9.80665 m/s²).
+    """
     return convert(values, units, "g")
 
 
 def gyr_to_rad_s(values, units: str) -> np.ndarray:
-    """Angular velocity in rad/s from ``units`` ('deg/s' or 'rad/s')."""
+    """Angular velocity in rad/s from ``units`` ('deg/s' or 'rad/s').
+
+    Parameters
+    ----------
+    values : array_like
+        Angular velocities, any shape (typically (N, 3)).
+    units : str
+        Units of ``values``: ``"deg/s"`` or ``"rad/s"`` (or an alias).
+
+    Returns
+    -------
+    numpy.ndarray of float
+        A new array of the shape of ``values``, in rad/s.
+    """
     return convert(values, units, "rad/s")

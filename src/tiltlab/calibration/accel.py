@@ -89,7 +89,24 @@ def _points(
 
 
 def norm_error(points, offset=None, matrix=None, radius: float = 1.0) -> np.ndarray:
-    r"""Signed norm error :math:`\|C(a - o)\| - r` of (corrected) static readings."""
+    r"""Signed norm error :math:`\|C(a - o)\| - r` of (corrected) static readings.
+
+    Parameters
+    ----------
+    points : array_like, shape (..., 3)
+        Static readings (e.g. accelerometer means, in g).
+    offset : array_like, shape (3,), optional
+        Offset :math:`o` subtracted first (units of ``points``); default none.
+    matrix : array_like, shape (3, 3), optional
+        Correction matrix :math:`C` applied after the offset; default identity.
+    radius : float
+        Expected norm :math:`r` (units of ``points``; 1 for g).
+
+    Returns
+    -------
+    numpy.ndarray, shape (...)
+        Norm error per reading (units of ``points``).
+    """
     p = vec3(points, "points")
     d = p - (0.0 if offset is None else vec3(offset, "offset", ndim=1))
     if matrix is not None:
@@ -242,6 +259,21 @@ def identifiable_matrix(matrix) -> np.ndarray:
 
     Norm-based fits determine only :math:`C^\top C = R^\top R`; compare a fitted
     triangular :math:`C` with the truth through ``identifiable_matrix(C_true)``.
+
+    Parameters
+    ----------
+    matrix : array_like, shape (3, 3)
+        An invertible correction matrix :math:`C`.
+
+    Returns
+    -------
+    numpy.ndarray, shape (3, 3)
+        Upper-triangular :math:`R` with a positive diagonal.
+
+    Raises
+    ------
+    ValueError
+        If ``matrix`` is singular.
     """
     C = mat3(matrix, "matrix")
     if np.linalg.matrix_rank(C) < 3:
@@ -483,6 +515,27 @@ def fit_known_directions(
     Each axis i is an ordinary least-squares regression of :math:`y_{p,i}` on
     :math:`(g_p^\top, 1)`; needs P ≥ 4 non-coplanar directions (P ≥ 5 for standard
     errors). T includes the mounting rotation of the sensor in the stage frame.
+
+    Parameters
+    ----------
+    points : array_like, shape (P, 3)
+        Static readings :math:`y_p` (e.g. accelerometer means, in g).
+    directions : array_like, shape (P, 3)
+        True unit directions :math:`g_p` of gravity in the stage frame, one per pose.
+    max_condition : float
+        Largest accepted condition number of the design matrix; beyond it the poses
+        are too close to coplanar.
+
+    Returns
+    -------
+    LinearFit
+        ``offset`` (3,), ``sensor_matrix`` T (3, 3), ``matrix`` :math:`C = T^{-1}`,
+        their standard errors (NaN for P = 4), ``residuals`` (P, 3) and ``n`` = P.
+
+    Raises
+    ------
+    CalibrationError
+        Fewer than 4 poses, or an ill-conditioned design.
     """
     y = vec3(points, "points", ndim=2)
     g = vec3(directions, "directions", ndim=2)
@@ -518,7 +571,20 @@ def fit_known_directions(
 
 def lattice_subset(directions, k: int) -> np.ndarray:
     """Indices of ``k`` of the given directions best matching a k-point Fibonacci lattice
-    (greedy nearest neighbour, each direction used once; Fayat Fig. 1c for N ≥ 5)."""
+    (greedy nearest neighbour, each direction used once; Fayat Fig. 1c for N ≥ 5).
+
+    Parameters
+    ----------
+    directions : array_like, shape (N, 3)
+        Candidate unit directions (e.g. the poses of a tumble test).
+    k : int
+        Number of directions to choose, ``1 <= k <= N``.
+
+    Returns
+    -------
+    numpy.ndarray of int64, shape (k,)
+        Indices into ``directions``, in lattice order.
+    """
     d = vec3(directions, "directions", ndim=2)
     k = _v.integer(k, "k", minimum=1)
     if k > d.shape[0]:
@@ -535,7 +601,23 @@ def lattice_subset(directions, k: int) -> np.ndarray:
 
 
 def triplet_orthogonality(directions) -> np.ndarray:
-    r"""|det[u_1 u_2 u_3]| of unit directions (…, 3, 3): 1 for mutually orthogonal, 0 for coplanar."""
+    r"""|det[u_1 u_2 u_3]| of unit directions (…, 3, 3): 1 for mutually orthogonal, 0 for coplanar.
+
+    Parameters
+    ----------
+    directions : array_like, shape (..., 3, 3)
+        Triplets of directions (rows; normalised here, any non-zero length).
+
+    Returns
+    -------
+    numpy.ndarray, shape (...)
+        The absolute determinant, in [0, 1].
+
+    Raises
+    ------
+    ValueError
+        If a direction is a zero vector.
+    """
     d = vec3(directions, "directions")
     nd = np.linalg.norm(d, axis=-1, keepdims=True)
     if np.any(nd == 0):
@@ -547,7 +629,25 @@ def triplet_orthogonality(directions) -> np.ndarray:
 def all_subsets(
     n: int, k: int, *, max_subsets: int | None = None, rng=None
 ) -> np.ndarray:
-    """All k-subsets of range(n) as an int array (S, k), or ``max_subsets`` of them drawn at random."""
+    """All k-subsets of range(n) as an int array (S, k), or ``max_subsets`` of them drawn at random.
+
+    Parameters
+    ----------
+    n : int
+        Size of the set, ``range(n)``.
+    k : int
+        Size of each subset.
+    max_subsets : int, optional
+        If there are more than this many subsets, draw this many at random (with
+        replacement between draws, so duplicates are possible); default all.
+    rng : int or numpy.random.Generator, optional
+        Seed or generator for the random draw.
+
+    Returns
+    -------
+    numpy.ndarray of int64, shape (S, k)
+        One subset per row, indices sorted within each row.
+    """
     from math import comb
 
     n = _v.integer(n, "n", minimum=0)
@@ -580,6 +680,23 @@ def offset_systematic_uncertainty(
     Drawing :math:`T = (I + \mathrm{diag}(s))(I + E)` with :math:`s \sim N(0, \sigma_s)`,
     off-diagonal :math:`E \sim N(0, \sigma_m)` gives the systematic uncertainty that the
     data cannot remove.
+
+    Parameters
+    ----------
+    points : array_like, shape (P, 3)
+        Static accelerometer means (units of ``radius``, e.g. g), P ≥ 3.
+    scale_sd : float
+        Standard deviation :math:`\sigma_s` of the scale errors (fraction, e.g. 0.01 for
+        1 %).
+    misalign_sd : float
+        Standard deviation :math:`\sigma_m` of the off-diagonal misalignment terms
+        (radians, small-angle).
+    n_draws : int
+        Number of drawn matrices T (≥ 2).
+    radius : float
+        Norm of the readings at rest (1 for g).
+    rng : int or numpy.random.Generator, optional
+        Seed or generator for the draws.
 
     Returns
     -------

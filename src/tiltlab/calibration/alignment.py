@@ -61,6 +61,22 @@ def head_frame_from_markers(p1, p2, p3) -> np.ndarray:
 
     Validates the markers, then calls the single implementation,
     :func:`tiltlab.frames.head_frame_from_markers`.
+
+    Parameters
+    ----------
+    p1, p2, p3 : array_like, shape (..., 3)
+        Positions of the three head markers (world frame, any length unit); NaN marks
+        a missing marker.
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., 3, 3)
+        Head→world rotation matrices.
+
+    Raises
+    ------
+    CalibrationError
+        Coincident or collinear markers.
     """
     a, b, c = (np.asarray(p, float) for p in (p1, p2, p3))
     if a.shape != b.shape or a.shape != c.shape or a.shape[-1] != 3:
@@ -79,7 +95,20 @@ def head_frame_from_markers(p1, p2, p3) -> np.ndarray:
 
 
 def tilt_from_markers(p1, p2, p3) -> np.ndarray:
-    """Head tilt: the world vertical m_z in head coordinates, R(head)ᵀ e_z (…, 3)."""
+    """Head tilt: the world vertical m_z in head coordinates, R(head)ᵀ e_z (…, 3).
+
+    Parameters
+    ----------
+    p1, p2, p3 : array_like, shape (..., 3)
+        Positions of the three head markers (world frame, any length unit); NaN marks
+        a missing marker.
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., 3)
+        Unit vectors of the world vertical in head coordinates (NaN where a marker is
+        missing).
+    """
     return head_frame_from_markers(p1, p2, p3)[..., 2, :]
 
 
@@ -99,6 +128,18 @@ def optical_tilt_uncertainty(sigma, median_distance) -> float:
     """Optical tilt uncertainty (°): arctan(σ_d / median d) (Fayat §2.6.3).
 
     ``sigma`` and ``median_distance`` are in the same length unit (e.g. mm).
+
+    Parameters
+    ----------
+    sigma : float
+        Standard deviation σ_d of the marker distance (≥ 0).
+    median_distance : float
+        Median marker distance d (> 0).
+
+    Returns
+    -------
+    float
+        The uncertainty (degrees).
     """
     sigma = _v.nonnegative(sigma, "sigma")
     median_distance = _v.positive(median_distance, "median_distance")
@@ -110,6 +151,25 @@ def marker_distance_qc(p1, p2, *, drop_fraction: float = 0.02) -> MarkerQC:
 
     Frames with a missing marker (NaN) are dropped as well and do not count in the
     fraction.
+
+    Parameters
+    ----------
+    p1, p2 : array_like, shape (N, 3)
+        Positions of two markers (any length unit, e.g. mm); NaN marks a missing
+        marker.
+    drop_fraction : float
+        Fraction of the valid frames dropped, in [0, 1) (default 0.02, 2 %).
+
+    Returns
+    -------
+    MarkerQC
+        ``keep`` (N,) bool, ``distance`` (N,), ``median``, ``sigma_all``,
+        ``sigma_kept`` (units of the markers) and ``tilt_uncertainty_deg`` (°).
+
+    Raises
+    ------
+    CalibrationError
+        Fewer than three frames with both markers.
     """
     a = _v.vectors(p1, "p1", allow_nan=True)
     b = _v.vectors(p2, "p2", allow_nan=True)
@@ -219,6 +279,16 @@ def mounting_rotation(acc_rest) -> np.ndarray:
 
     ``acc_rest`` is a tiltlab specific-force reading (or several, averaged) taken with
     the animal resting level; apply as ``B = M @ D``.
+
+    Parameters
+    ----------
+    acc_rest : array_like, shape (3,) or (N, 3)
+        Specific force at level rest (any unit; several readings are averaged).
+
+    Returns
+    -------
+    numpy.ndarray, shape (3, 3)
+        The device→body rotation matrix ``M``.
     """
     a = vec3(acc_rest, "acc_rest")
     if a.ndim == 2:

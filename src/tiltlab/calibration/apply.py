@@ -184,7 +184,19 @@ class Calibration:
 
 
 def applied_calibrations(rec: xr.Dataset) -> list[dict]:
-    """The calibrations recorded in ``rec.attrs["calibration"]`` (oldest first)."""
+    """The calibrations recorded in ``rec.attrs["calibration"]`` (oldest first).
+
+    Parameters
+    ----------
+    rec : xarray.Dataset
+        A Recording.
+
+    Returns
+    -------
+    list of dict
+        One entry per applied calibration (``name``, ``fingerprint``, ``applied``,
+        ``calibration``); empty if none was applied.
+    """
     raw = rec.attrs.get("calibration")
     if raw is None:
         return []

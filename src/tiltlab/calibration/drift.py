@@ -54,7 +54,18 @@ _METHODS = ("first_window", "linear_fit", "prior", "none")
 
 
 def deg_per_hour(rate_deg_s) -> np.ndarray:
-    """Angle accumulated in one hour (°) by a constant rate error (°/s): ``3600 × rate``."""
+    """Angle accumulated in one hour (°) by a constant rate error (°/s): ``3600 × rate``.
+
+    Parameters
+    ----------
+    rate_deg_s : array_like
+        Rate error(s) (°/s), any shape.
+
+    Returns
+    -------
+    numpy.ndarray of float
+        Accumulated angle (°) after one hour, shape of ``rate_deg_s``.
+    """
     return np.asarray(rate_deg_s, dtype=float) * 3600.0
 
 
@@ -297,6 +308,21 @@ def allan_noise_parameters(taus_s, adev) -> AllanNoise:
     ARW: median of σ(τ)√τ over the points where the local log-log slope is within
     ±0.15 of −1/2; bias instability: min σ / 0.664; RRW: median of σ(τ)√(3/τ) where the
     slope is within ±0.15 of +1/2.
+
+    Parameters
+    ----------
+    taus_s : array_like, shape (K,)
+        Averaging times τ (s), positive.
+    adev : array_like, shape (K,) or (K, k)
+        Allan deviations σ(τ) (≥ 0) of one or ``k`` channels, in the rate unit (e.g.
+        °/s).
+
+    Returns
+    -------
+    AllanNoise
+        Angle random walk, bias instability, the τ of the minimum (s) and rate random
+        walk: floats for 1-D ``adev``, arrays (k,) otherwise; NaN where no point of the
+        curve has the needed slope.
     """
     t = _v.vectors(taus_s, "taus_s", width=None, ndim=1)
     if np.any(t <= 0):

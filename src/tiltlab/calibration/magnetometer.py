@@ -55,11 +55,17 @@ def four_point_poses(
 ) -> tuple[np.ndarray, np.ndarray]:
     """Sensor→world (ENU) quaternions of the eight poses of the four-point procedure.
 
+    Parameters
+    ----------
+    flank_on : {"left", "right"}
+        The flank the device rests on during the flank rotation (default left).
+
     Returns
     -------
     bottom, flank : ndarray (4, 4)
         Surge axis horizontal pointing N, E, S, W (rows), resting on the bottom (level)
         and on the ``flank_on`` flank (bank −90° for the left flank: sway axis down).
+        Quaternions are scalar-first (w, x, y, z).
     """
     flank_on = _flank(flank_on)
     az = np.array([np.pi / 2, 0.0, -np.pi / 2, np.pi])  # N, E, S, W, ccw from East

@@ -64,7 +64,29 @@ def _vqf(acc, gyr, fs, mag, offline: bool, params: dict) -> np.ndarray:
 
 def run_vqf(acc, gyr, fs: float | None = None, *, mag=None, **vqf_params) -> np.ndarray:
     """VQF (``vqf.VQF(...).updateBatch``), 6D or 9D; ``vqf_params`` are the ``vqf``
-    package's own parameters with its own defaults (e.g. ``tauAcc`` in s)."""
+    package's own parameters with its own defaults (e.g. ``tauAcc`` in s).
+
+    Parameters
+    ----------
+    acc : array_like or xarray.DataArray, shape (N, 3)
+        Specific force, m/s² (a labelled DataArray: converted from its ``units``).
+    gyr : array_like or xarray.DataArray, shape (N, 3)
+        Angular rate, rad/s (a labelled DataArray: converted from its ``units``).
+    fs : float, optional
+        Sampling rate, Hz (mandatory for plain arrays; labelled inputs may carry it
+        as ``attrs["fs"]``).
+    mag : array_like or xarray.DataArray, shape (N, 3), optional
+        Magnetic field (any consistent unit); given, the 9D filter runs, else 6D.
+    **vqf_params
+        Parameters of ``vqf.VQF`` (e.g. ``tauAcc`` in s); an unknown name is a
+        ValueError.
+
+    Returns
+    -------
+    numpy.ndarray, shape (N, 4)
+        Unit quaternions (w, x, y, z) sensor → world, world z up (heading arbitrary
+        in 6D).
+    """
     return _vqf(acc, gyr, fs, mag, False, vqf_params)
 
 
@@ -72,7 +94,29 @@ def run_offline_vqf(
     acc, gyr, fs: float | None = None, *, mag=None, **vqf_params
 ) -> np.ndarray:
     """offlineVQF (``vqf.offlineVQF``, non-causal), 6D or 9D; ``vqf_params`` as for
-    :func:`run_vqf`."""
+    :func:`run_vqf`.
+
+    Parameters
+    ----------
+    acc : array_like or xarray.DataArray, shape (N, 3)
+        Specific force, m/s² (a labelled DataArray: converted from its ``units``).
+    gyr : array_like or xarray.DataArray, shape (N, 3)
+        Angular rate, rad/s (a labelled DataArray: converted from its ``units``).
+    fs : float, optional
+        Sampling rate, Hz (mandatory for plain arrays; labelled inputs may carry it
+        as ``attrs["fs"]``).
+    mag : array_like or xarray.DataArray, shape (N, 3), optional
+        Magnetic field (any consistent unit); given, the 9D filter runs, else 6D.
+    **vqf_params
+        Parameters of ``vqf.offlineVQF`` (e.g. ``tauAcc`` in s); an unknown name is a
+        ValueError.
+
+    Returns
+    -------
+    numpy.ndarray, shape (N, 4)
+        Unit quaternions (w, x, y, z) sensor → world, world z up (heading arbitrary
+        in 6D).
+    """
     return _vqf(acc, gyr, fs, mag, True, vqf_params)
 
 
@@ -90,6 +134,27 @@ def run_imufusion(
     ``gyr`` rad/s → °/s and ``acc`` m/s² → g for the package; ``gain`` is Fusion's
     gain, ``acceleration_rejection_deg`` its acceleration-rejection threshold (°) and
     ``rejection_timeout_s`` its rejection timeout (s).
+
+    Parameters
+    ----------
+    acc : array_like or xarray.DataArray, shape (N, 3)
+        Specific force, m/s² (a labelled DataArray: converted from its ``units``).
+    gyr : array_like or xarray.DataArray, shape (N, 3)
+        Angular rate, rad/s (a labelled DataArray: converted from its ``units``).
+    fs : float, optional
+        Sampling rate, Hz (mandatory for plain arrays; labelled inputs may carry it
+        as ``attrs["fs"]``).
+    gain : float
+        Fusion's gain (≥ 0; 0 integrates the gyroscope alone).
+    acceleration_rejection_deg : float
+        Acceleration-rejection threshold (°).
+    rejection_timeout_s : float
+        Rejection timeout (s).
+
+    Returns
+    -------
+    numpy.ndarray, shape (N, 4)
+        Unit quaternions (w, x, y, z) sensor → world, world z up, heading arbitrary.
     """
     import imufusion
 
@@ -128,7 +193,28 @@ def run_ahrs_madgwick(
     acc, gyr, fs: float | None = None, *, beta: float = 0.05, init_window_s: float = 0.1
 ) -> np.ndarray:
     """``ahrs.filters.Madgwick`` (6D) with an explicit ``frequency``, started at
-    :func:`initial_orientation` of the first ``init_window_s`` seconds."""
+    :func:`initial_orientation` of the first ``init_window_s`` seconds.
+
+    Parameters
+    ----------
+    acc : array_like or xarray.DataArray, shape (N, 3)
+        Specific force, m/s² (a labelled DataArray: converted from its ``units``).
+    gyr : array_like or xarray.DataArray, shape (N, 3)
+        Angular rate, rad/s (a labelled DataArray: converted from its ``units``).
+    fs : float, optional
+        Sampling rate, Hz (mandatory for plain arrays; labelled inputs may carry it
+        as ``attrs["fs"]``).
+    beta : float
+        Madgwick's gain β (≥ 0, rad/s).
+    init_window_s : float
+        Duration (s) of the start of the record whose mean orientation starts the
+        filter.
+
+    Returns
+    -------
+    numpy.ndarray, shape (N, 4)
+        Unit quaternions (w, x, y, z) sensor → world, world z up, heading arbitrary.
+    """
     import ahrs.filters as af
 
     acc, gyr, fs, q0 = _ahrs_start(acc, gyr, fs, init_window_s)
@@ -150,6 +236,28 @@ def run_ahrs_mahony(
 
     ``ahrs`` rejects ``k_I = 0`` (and ``k_P = 0``); the smallest positive float stands
     in for zero.
+
+    Parameters
+    ----------
+    acc : array_like or xarray.DataArray, shape (N, 3)
+        Specific force, m/s² (a labelled DataArray: converted from its ``units``).
+    gyr : array_like or xarray.DataArray, shape (N, 3)
+        Angular rate, rad/s (a labelled DataArray: converted from its ``units``).
+    fs : float, optional
+        Sampling rate, Hz (mandatory for plain arrays; labelled inputs may carry it
+        as ``attrs["fs"]``).
+    kp : float
+        Proportional gain k_P (≥ 0).
+    ki : float
+        Integral gain k_I (≥ 0; 1/s).
+    init_window_s : float
+        Duration (s) of the start of the record whose mean orientation starts the
+        filter.
+
+    Returns
+    -------
+    numpy.ndarray, shape (N, 4)
+        Unit quaternions (w, x, y, z) sensor → world, world z up, heading arbitrary.
     """
     import ahrs.filters as af
 
@@ -170,7 +278,30 @@ def run_ahrs_ekf(
     init_window_s: float = 0.1,
 ) -> np.ndarray:
     """``ahrs.filters.EKF`` (6D) with ``frame='NED'`` (really z up: ``ahrs``'s
-    ``frame='ENU'`` is upside down), started as :func:`run_ahrs_madgwick`."""
+    ``frame='ENU'`` is upside down), started as :func:`run_ahrs_madgwick`.
+
+    Parameters
+    ----------
+    acc : array_like or xarray.DataArray, shape (N, 3)
+        Specific force, m/s² (a labelled DataArray: converted from its ``units``).
+    gyr : array_like or xarray.DataArray, shape (N, 3)
+        Angular rate, rad/s (a labelled DataArray: converted from its ``units``).
+    fs : float, optional
+        Sampling rate, Hz (mandatory for plain arrays; labelled inputs may carry it
+        as ``attrs["fs"]``).
+    var_gyr : float
+        Gyroscope noise variance ((rad/s)², ≥ 0).
+    var_acc : float
+        Accelerometer noise variance ((m/s²)², > 0).
+    init_window_s : float
+        Duration (s) of the start of the record whose mean orientation starts the
+        filter.
+
+    Returns
+    -------
+    numpy.ndarray, shape (N, 4)
+        Unit quaternions (w, x, y, z) sensor → world, world z up, heading arbitrary.
+    """
     import ahrs.filters as af
 
     acc, gyr, fs, q0 = _ahrs_start(acc, gyr, fs, init_window_s)

@@ -130,6 +130,20 @@ def run(method: str, inputs: Inputs, **params) -> np.ndarray:
     parameter is a ValueError naming it; a method that needs a sensor the inputs lack
     (a gyroscope, a magnetometer) is a :class:`~tiltlab._validate.RecordingError` naming
     it and the methods that would run.
+
+    Parameters
+    ----------
+    method : str
+        A registered method name (see :mod:`tiltlab.filters.registry`).
+    inputs : Inputs
+        Prepared sensor inputs (acc in m/s², gyr in rad/s, fs in Hz, optional mag).
+    **params
+        Method parameters, overriding the registry's defaults.
+
+    Returns
+    -------
+    numpy.ndarray, shape (N, 4)
+        Unit quaternions (w, x, y, z) sensor → world.
     """
     m = get_method(method)
     full = m.resolve(params)

@@ -438,6 +438,20 @@ def missing_sensor_message(
 
     It names the method and the sensor it needs, and lists the methods that run on the
     variables ``have`` (and those that would with a magnetometer too).
+
+    Parameters
+    ----------
+    method : Method or str
+        The refused method (or its name).
+    missing : str
+        The variable the data lack: ``"acc"``, ``"gyr"`` or ``"mag"``.
+    have : collection of str
+        The variables the data have (default accelerometer only).
+
+    Returns
+    -------
+    str
+        The error message.
     """
     m = get_method(method) if isinstance(method, str) else method
     what = {"gyr": "a gyroscope", "mag": "a magnetometer", "acc": "an accelerometer"}
@@ -458,7 +472,18 @@ def missing_sensor_message(
 
 def get_method(name: str) -> Method:
     """The registry entry of ``name``; an unknown name is a ValueError listing the
-    valid ones."""
+    valid ones.
+
+    Parameters
+    ----------
+    name : str
+        A registered method name (a key of ``METHODS``).
+
+    Returns
+    -------
+    Method
+        The registry entry.
+    """
     try:
         return METHODS[name]
     except (KeyError, TypeError):
@@ -468,5 +493,16 @@ def get_method(name: str) -> Method:
 
 
 def defaults(name: str) -> dict[str, Any]:
-    """Parameter defaults of method ``name`` (read from its function's signature)."""
+    """Parameter defaults of method ``name`` (read from its function's signature).
+
+    Parameters
+    ----------
+    name : str
+        A registered method name.
+
+    Returns
+    -------
+    dict
+        Parameter name → default value.
+    """
     return get_method(name).defaults

@@ -95,7 +95,19 @@ def open_netcdf(path: PathLike) -> xr.Dataset:
 
 
 def is_recording(ds: xr.Dataset) -> bool:
-    """True if an opened NetCDF file holds a tiltlab Recording (or a file tiltlab wrote)."""
+    """True if an opened NetCDF file holds a tiltlab Recording (or a file tiltlab wrote).
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        An opened NetCDF file.
+
+    Returns
+    -------
+    bool
+        True if ``ds`` carries tiltlab's attributes, or has an ``acc`` variable, a
+        ``time`` dimension and an ``fs`` attribute.
+    """
     if _ATTRS_KEY in ds.attrs:
         return True
     return "acc" in ds.data_vars and "time" in ds.dims and "fs" in ds.attrs

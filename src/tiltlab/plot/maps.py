@@ -111,6 +111,17 @@ def axis_texts(obj: Any = None) -> dict[str, str]:
     ``"+x (nose)"`` where the data name the axis (:func:`axis_names`), ``"+x"`` where
     they do not; negative axes are ``"−x"`` etc.
 
+    Parameters
+    ----------
+    obj : optional
+        Data with ``attrs["axis_labels"]`` or three axis names (see
+        :func:`axis_names`); None gives plain names.
+
+    Returns
+    -------
+    dict of str to str
+        Keys ``"+x"``, ``"-x"``, ``"+y"``, ``"-y"``, ``"+z"``, ``"-z"`` → texts.
+
     Examples
     --------
     >>> axis_texts(["right", "top", "out of screen"])["+y"]
@@ -138,6 +149,18 @@ def laea(centre=(0.0, 0.0, 1.0), *, nose_up: bool | None = None):
     there) rotates it so that +x points up and +y left, as when looking down on an
     animal whose x axis is forward (the nose of a rat head); other centres keep +z
     (north) up.
+
+    Parameters
+    ----------
+    centre : array_like, shape (3,)
+        Direction of the map centre (any non-zero length; default +z).
+    nose_up : bool, optional
+        Put longitude 0 (+x) at the top; default True when ``centre`` is +z, else False.
+
+    Returns
+    -------
+    cartopy.crs.LambertAzimuthalEqualArea
+        The projection, on the unit-sphere globe (:func:`unit_globe`).
     """
     import cartopy.crs as ccrs
 
@@ -158,7 +181,19 @@ def tilt_projection():
 
 
 def lonlat_deg(vectors) -> tuple[np.ndarray, np.ndarray]:
-    """Longitude and latitude (degrees) of directions."""
+    """Longitude and latitude (degrees) of directions.
+
+    Parameters
+    ----------
+    vectors : array_like, shape (..., 3)
+        Directions (sensor-frame unit vectors).
+
+    Returns
+    -------
+    lon, lat : numpy.ndarray, shape (...)
+        Longitude (degrees, measured from +x towards +y) and latitude (degrees, positive
+        towards +z).
+    """
     lon, lat = S.to_lonlat(np.asarray(vectors, float))
     return np.degrees(lon), np.degrees(lat)
 
@@ -171,7 +206,20 @@ def _centre(proj) -> np.ndarray:
 
 
 def project(proj, vectors) -> np.ndarray:
-    """Projected map coordinates (..., 2) of directions (cartopy transform from lon/lat on the same globe)."""
+    """Projected map coordinates (..., 2) of directions (cartopy transform from lon/lat on the same globe).
+
+    Parameters
+    ----------
+    proj : cartopy.crs.Projection
+        The map projection (e.g. from :func:`laea`, or ``ax.projection``).
+    vectors : array_like, shape (..., 3)
+        Directions (unit vectors).
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., 2)
+        Map coordinates (x, y) in the projection's units (unit sphere).
+    """
     import cartopy.crs as ccrs
 
     v = np.asarray(vectors, float)
@@ -185,6 +233,21 @@ def map_axes(fig, spec=111, centre=(0.0, 0.0, 1.0), **kw):
 
     ``spec`` is anything ``fig.add_subplot`` takes: ``121``, a tuple ``(nrows, ncols,
     index)`` or a SubplotSpec.
+
+    Parameters
+    ----------
+    fig : matplotlib.figure.Figure
+        The figure to add the axes to.
+    spec : int, tuple or SubplotSpec
+        Position of the axes (default ``111``, the whole figure).
+    centre : array_like, shape (3,)
+        Direction of the map centre (default +z).
+    **kw
+        Passed to :func:`laea` (``nose_up``).
+
+    Returns
+    -------
+    cartopy.mpl.geoaxes.GeoAxes
     """
     proj = laea(centre, **kw)
     ax = fig.add_subplot(
@@ -202,7 +265,28 @@ def _far_from_antipode(proj, vectors, min_deg: float) -> np.ndarray:
 def plot_facets(
     ax, values, mesh: S.SphereMesh | None = None, *, antipode_deg: float = 4.0, **kw
 ):
-    """Colour the facets of a triangulated sphere by ``values`` (F,) on a LAEA GeoAxes (``ax.tripcolor``)."""
+    """Colour the facets of a triangulated sphere by ``values`` (F,) on a LAEA GeoAxes (``ax.tripcolor``).
+
+    Parameters
+    ----------
+    ax : cartopy.mpl.geoaxes.GeoAxes
+        A LAEA map (e.g. from :func:`map_axes`).
+    values : array_like, shape (F,)
+        One value per facet of ``mesh``.
+    mesh : tiltlab.sphere.SphereMesh, optional
+        The triangulated sphere; default :func:`tiltlab.sphere.sphere_mesh`.
+    antipode_deg : float
+        Facets with a vertex within this angle (degrees) of the map's antipode, where
+        the projection tears, are not drawn.
+    **kw
+        Passed to ``ax.tripcolor`` (``cmap``, ``norm``...; ``shading`` defaults to
+        ``"flat"``, ``edgecolors`` to ``"none"``).
+
+    Returns
+    -------
+    matplotlib.collections.PolyCollection
+        The artist returned by ``tripcolor`` (for a colour bar).
+    """
     mesh = S.sphere_mesh() if mesh is None else mesh
     values = np.asarray(values, float)
     if values.shape != (mesh.n_faces,):
@@ -233,7 +317,27 @@ def plot_mask(
     alpha: float = 0.6,
     **kw,
 ):
-    """Fill the facets where ``mask`` is True with one colour (binarised map, Fayat Fig. 3c–d)."""
+    """Fill the facets where ``mask`` is True with one colour (binarised map, Fayat Fig. 3c–d).
+
+    Parameters
+    ----------
+    ax : cartopy.mpl.geoaxes.GeoAxes
+        A LAEA map.
+    mask : array_like of bool, shape (F,)
+        One value per facet of ``mesh``.
+    mesh : tiltlab.sphere.SphereMesh, optional
+        The triangulated sphere; default :func:`tiltlab.sphere.sphere_mesh`.
+    color : colour
+        Fill colour of the True facets (False facets are transparent).
+    alpha : float
+        Opacity of the fill (0–1).
+    **kw
+        Passed to :func:`plot_facets`.
+
+    Returns
+    -------
+    matplotlib.collections.PolyCollection
+    """
     from matplotlib.colors import ListedColormap
 
     mask = np.asarray(mask, bool)
@@ -251,7 +355,32 @@ def _grid_xy(ax, grid, antipode_deg):
 
 
 def plot_grid(ax, kde_or_values, grid=None, *, antipode_deg: float = 4.0, **kw):
-    """Colour the cells of an equal-area grid (a :class:`~tiltlab.sphere.SphericalKDE` or values + grid) on a LAEA map."""
+    """Colour the cells of an equal-area grid (a :class:`~tiltlab.sphere.SphericalKDE` or values + grid) on a LAEA map.
+
+    Parameters
+    ----------
+    ax : cartopy.mpl.geoaxes.GeoAxes
+        A LAEA map.
+    kde_or_values : tiltlab.sphere.SphericalKDE or array_like
+        A KDE (its ``density`` on its ``grid``), or values of the shape of ``grid``.
+    grid : optional
+        The equal-area grid of the values; ignored for a KDE.
+    antipode_deg : float
+        Cells within this angle (degrees) of the map's antipode are masked.
+    **kw
+        Passed to ``ax.pcolormesh`` (``shading`` defaults to ``"flat"``,
+        ``rasterized`` to True).
+
+    Returns
+    -------
+    matplotlib.collections.QuadMesh
+        The artist returned by ``pcolormesh``.
+
+    Raises
+    ------
+    ValueError
+        If the values do not match the grid's shape, or no grid is given.
+    """
     if isinstance(kde_or_values, S.SphericalKDE):
         values, grid = kde_or_values.density, kde_or_values.grid
     else:
@@ -268,7 +397,25 @@ def plot_grid(ax, kde_or_values, grid=None, *, antipode_deg: float = 4.0, **kw):
 def plot_isopleths(
     ax, kde_result, levels=(0.5, 0.95), *, antipode_deg: float = 10.0, **kw
 ):
-    """Draw cumulative isopleth lines (e.g. 0.50 and 0.95) of a spherical KDE on a LAEA map."""
+    """Draw cumulative isopleth lines (e.g. 0.50 and 0.95) of a spherical KDE on a LAEA map.
+
+    Parameters
+    ----------
+    ax : cartopy.mpl.geoaxes.GeoAxes
+        A LAEA map.
+    kde_result : tiltlab.sphere.SphericalKDE
+        The KDE (``density`` on ``grid``).
+    levels : sequence of float
+        Cumulative probabilities enclosed by the lines (fractions in (0, 1)).
+    antipode_deg : float
+        Cells within this angle (degrees) of the map's antipode are masked.
+    **kw
+        Passed to ``ax.contour`` (``colors`` defaults to ``"k"``, ``linewidths`` to 1).
+
+    Returns
+    -------
+    matplotlib.contour.QuadContourSet
+    """
     grid = kde_result.grid
     thr = S.isopleths(kde_result, levels=levels)["threshold"].to_numpy()
     order = np.argsort(thr)
@@ -285,7 +432,23 @@ def plot_isopleths(
 
 
 def plot_points(ax, vectors, *, antipode_deg: float = 2.0, **kw):
-    """Plot directions (a trajectory or a few points) on a LAEA map; points near the antipode are dropped."""
+    """Plot directions (a trajectory or a few points) on a LAEA map; points near the antipode are dropped.
+
+    Parameters
+    ----------
+    ax : cartopy.mpl.geoaxes.GeoAxes
+        A LAEA map.
+    vectors : array_like, shape (N, 3) or (3,)
+        Directions (unit vectors).
+    antipode_deg : float
+        Points within this angle (degrees) of the map's antipode become NaN (gaps).
+    **kw
+        Passed to ``ax.plot`` (line and marker style).
+
+    Returns
+    -------
+    list of matplotlib.lines.Line2D
+    """
     v = np.atleast_2d(np.asarray(vectors, float))
     xy = project(ax.projection, v)
     far = _far_from_antipode(ax.projection, v, antipode_deg)
@@ -311,6 +474,28 @@ def decorate(
     Recording, a tilt series or map), or the three names; ``None`` gives plain
     ``+x``, ``+y``, ``+z``. Axes within 30° of the map's antipode, or outside the axes'
     extent, are not labelled.
+
+    Parameters
+    ----------
+    ax : cartopy.mpl.geoaxes.GeoAxes
+        A LAEA map.
+    labels : dict, optional
+        Key of ``SENSOR_AXES`` → text; default :func:`axis_texts` of ``axis_labels``.
+    axis_labels : optional
+        Labelled data or three axis names (see above).
+    equator : bool
+        Draw the equator (the plane of the x and y axes), default True.
+    grid_step_deg : float
+        Spacing of meridians and parallels (degrees).
+    gridline_kw : dict, optional
+        Style of the gridlines, updating the default (grey dotted).
+    fontsize : float
+        Font size of the axis labels (points).
+
+    Returns
+    -------
+    cartopy.mpl.geoaxes.GeoAxes
+        ``ax``.
     """
     import cartopy.crs as ccrs
 
@@ -372,6 +557,32 @@ def sphere_3d(
     ``ax`` must be a 3-D axes (``projection="3d"``); NaN values (e.g. unvisited facets)
     are drawn in ``nan_color``. The trajectory is drawn slightly outside the sphere, only
     where it faces the viewer, and above the facets.
+
+    Parameters
+    ----------
+    ax : mpl_toolkits.mplot3d.axes3d.Axes3D
+        A 3-D axes.
+    values : array_like, shape (F,)
+        One value per facet of ``mesh`` (NaN allowed).
+    mesh : tiltlab.sphere.SphereMesh, optional
+        The triangulated sphere; default :func:`tiltlab.sphere.sphere_mesh`.
+    cmap : str or Colormap
+        Colour map of the values.
+    norm : matplotlib.colors.Normalize, optional
+        Value → colour scaling; default linear between the finite minimum and maximum.
+    trajectory : array_like, shape (N, 3), optional
+        Directions to draw as a line on the sphere.
+    traj_kw : dict, optional
+        Style of the trajectory line, updating the default (white, width 1).
+    elev, azim : float
+        Elevation and azimuth of the viewpoint (degrees).
+    nan_color : colour
+        Colour of NaN facets.
+
+    Returns
+    -------
+    matplotlib.cm.ScalarMappable
+        The colour mapping (for a colour bar).
     """
     from matplotlib import colors as mcolors
     from mpl_toolkits.mplot3d.art3d import Poly3DCollection
