@@ -44,7 +44,20 @@ class StepSummary(NamedTuple):
 
 
 def window_length(window_s: float, fs: float) -> int:
-    """Number of samples k = round(f Δt) of a Δt window (at least 1)."""
+    """Number of samples k = round(f Δt) of a Δt window (at least 1).
+
+    Parameters
+    ----------
+    window_s : float
+        Window duration Δt (s).
+    fs : float
+        Sampling rate f (Hz).
+
+    Returns
+    -------
+    int
+        Window length k (samples), at least 1.
+    """
     return window_samples(window_s, fs)
 
 
@@ -100,6 +113,17 @@ def static_acceleration(
     window_s : float
         Window duration Δt (s).
     mode : {"sliding", "jumping"}
+
+    Returns
+    -------
+    numpy.ndarray or xarray.DataArray
+        Static acceleration, shape (N, 3) (``"sliding"``) or (N // k, 3)
+        (``"jumping"``), in the units of ``acc``.
+
+    Raises
+    ------
+    ValueError
+        If ``mode`` is neither ``"sliding"`` nor ``"jumping"``.
     """
     if mode not in ("sliding", "jumping"):
         raise ValueError(f"mode must be 'sliding' or 'jumping', got {mode!r}")
@@ -127,6 +151,20 @@ def dba(acc, fs=None, *, window_s: float):
 
     Posture-independent: it is invariant to any rotation of the device. Same units as
     ``acc``; see :func:`static_acceleration` for the inputs.
+
+    Parameters
+    ----------
+    acc : xarray.Dataset, xarray.DataArray or array_like (N, 3)
+        Acceleration (any unit, kept), e.g. in g or m/s².
+    fs : float, optional
+        Sampling rate (Hz) of a plain array; read from the attributes when labelled.
+    window_s : float
+        Window duration Δt (s) of the sliding static-acceleration mean.
+
+    Returns
+    -------
+    numpy.ndarray or xarray.DataArray (N,)
+        DBA per sample, in the units of ``acc``; NaN where the window touches a gap.
     """
     s = _read_acc(acc, fs)
     a = s.values
@@ -139,6 +177,20 @@ def odba(acc, fs=None, *, window_s: float):
 
     Shown for comparison only: it depends on the device orientation (it is not
     rotation invariant), unlike :func:`dba`.
+
+    Parameters
+    ----------
+    acc : xarray.Dataset, xarray.DataArray or array_like (N, 3)
+        Acceleration (any unit, kept), e.g. in g or m/s².
+    fs : float, optional
+        Sampling rate (Hz) of a plain array; read from the attributes when labelled.
+    window_s : float
+        Window duration Δt (s) of the sliding static-acceleration mean.
+
+    Returns
+    -------
+    numpy.ndarray or xarray.DataArray (N,)
+        ODBA per sample, in the units of ``acc``; NaN where the window touches a gap.
     """
     s = _read_acc(acc, fs)
     a = s.values
@@ -154,6 +206,22 @@ def step_summary(acc, fs=None, *, window_s: float) -> StepSummary:
     each consecutive block of k = round(fΔt) samples, and the per-sample DBA is
     averaged over the block. Trailing incomplete block dropped. ``time`` is the time of
     the centre sample (s, from the first sample or on the input's time axis).
+
+    Parameters
+    ----------
+    acc : xarray.Dataset, xarray.DataArray or array_like (N, 3)
+        Acceleration (any unit, kept), e.g. in g or m/s².
+    fs : float, optional
+        Sampling rate (Hz) of a plain array; read from the attributes when labelled.
+    window_s : float
+        Step duration Δt (s); k = round(fΔt) samples per step.
+
+    Returns
+    -------
+    StepSummary
+        ``time`` (N // k,) centre times (s; absolute times when the input is
+        labelled), ``static`` (N // k, 3) static acceleration and ``dba`` (N // k,)
+        mean DBA, both in the units of ``acc`` (DataArrays when the input is labelled).
     """
     s = _read_acc(acc, fs)
     a = s.values

@@ -188,6 +188,21 @@ def valley_threshold(speed, **kwargs) -> float:
 
     See :func:`speed_modes` for the method and keyword arguments.
 
+    Parameters
+    ----------
+    speed : xarray.DataArray or array_like (N,)
+        Angular speed (°/s for a plain array unless ``units`` says otherwise; a labelled
+        DataArray is converted from its units); NaN and non-positive values are ignored.
+    **kwargs
+        Passed to :func:`speed_modes`: ``units``, ``log_range``, ``bins``,
+        ``smooth_bins``, ``min_prominence``, ``min_separation``.
+
+    Returns
+    -------
+    float
+        Threshold (°/s): the valley of the smoothed log-speed histogram, resolved to one
+        histogram bin.
+
     Raises
     ------
     ValueError

@@ -79,7 +79,19 @@ def _tag(x: float) -> str:
 
 
 def feature_specs(config: FeatureConfig | None = None) -> dict[str, tuple[str, str]]:
-    """Feature names → (units, long_name), in output order, for a configuration."""
+    """Feature names → (units, long_name), in output order, for a configuration.
+
+    Parameters
+    ----------
+    config : FeatureConfig, optional
+        Feature configuration (thresholds, quantiles, mesh size ...); default
+        ``FeatureConfig()``.
+
+    Returns
+    -------
+    dict
+        Feature name -> ``(units, long_name)``, both str, in output order.
+    """
     c = config or FeatureConfig()
     thr = f"{c.threshold_deg_s:g} deg/s"
     spec = {
@@ -179,7 +191,19 @@ def _dataset(
 
 
 def empty_features(config: FeatureConfig | None = None) -> xr.Dataset:
-    """The feature Dataset of a configuration with every value NaN (a failed session)."""
+    """The feature Dataset of a configuration with every value NaN (a failed session).
+
+    Parameters
+    ----------
+    config : FeatureConfig, optional
+        Feature configuration; default ``FeatureConfig()``.
+
+    Returns
+    -------
+    xarray.Dataset
+        One NaN variable per feature of :func:`feature_specs`, with its units and
+        long name.
+    """
     return _dataset({}, config or FeatureConfig())
 
 

@@ -108,6 +108,22 @@ def compute_session(row: dict, root: str, config: FeatureConfig) -> dict[str, An
     Returns ``{"session", "status", "error", "features"}``: ``status`` is ``"ok"``
     with the feature Dataset, or ``"failed"`` with ``error`` = ``"<Type>: <message>"``
     and ``features`` None. This is the task :func:`run_cohort` submits.
+
+    Parameters
+    ----------
+    row : dict
+        Manifest row (``session``, ``file``, ``reader``, ``calibration``,
+        ``reader_options`` ...).
+    root : str
+        Directory that relative file paths in ``row`` are resolved against.
+    config : FeatureConfig
+        Feature configuration.
+
+    Returns
+    -------
+    dict
+        ``session`` (str), ``status`` (``"ok"`` or ``"failed"``), ``error`` (str,
+        empty when ok) and ``features`` (xarray.Dataset or None).
     """
     try:
         rec = load_session(row, root)
@@ -155,7 +171,25 @@ def cache_key(
     file's bytes, the reader and its options, the configuration's hash and the package
     version. None when a file cannot be read (such a session is always recomputed).
     ``digests`` (path → SHA-256) memoises file digests over one run (a subject's
-    calibration file serves several sessions)."""
+    calibration file serves several sessions).
+
+    Parameters
+    ----------
+    row : dict
+        Manifest row (``file``, ``reader``, ``reader_options``, ``calibration``).
+    root : str or os.PathLike
+        Directory that relative file paths in ``row`` are resolved against.
+    config : FeatureConfig
+        Feature configuration (its hash enters the key).
+    digests : dict, optional
+        Memo of file digests, path (str) -> SHA-256 hex digest or None; updated in
+        place.
+
+    Returns
+    -------
+    str or None
+        Hex SHA-256 key (64 characters), or None when a file cannot be read.
+    """
     memo = {} if digests is None else digests
 
     def digest(f) -> str | None:
@@ -466,7 +500,25 @@ class CohortSummary:
 
 
 def summary(features: xr.Dataset) -> CohortSummary:
-    """Counts of ok and failed sessions, and why each failed, of a cohort Dataset."""
+    """Counts of ok and failed sessions, and why each failed, of a cohort Dataset.
+
+    Parameters
+    ----------
+    features : xarray.Dataset
+        Cohort feature table along ``session`` with ``status`` and ``error`` (and
+        ``notes``), as from :func:`run_cohort` or :func:`load_features`.
+
+    Returns
+    -------
+    CohortSummary
+        Numbers of sessions, ok, failed, computed and cached sessions, and the
+        ``failures`` and ``notes`` by session.
+
+    Raises
+    ------
+    ValueError
+        If ``features`` has no ``status`` along a ``session`` dimension.
+    """
     if "status" not in features or "session" not in features.dims:
         raise ValueError("not a cohort feature table (no 'status' along 'session')")
     status = features["status"].values.astype(str)
@@ -496,14 +548,48 @@ def summary(features: xr.Dataset) -> CohortSummary:
 
 def save_features(ds: xr.Dataset, path) -> Path:
     """Save a feature table to NetCDF (exact round trip with :func:`load_features`),
-    atomically. :func:`~tiltlab.cohort.save_table` writes it as CSV or Parquet."""
+    atomically. :func:`~tiltlab.cohort.save_table` writes it as CSV or Parquet.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        Feature table.
+    path : str or os.PathLike
+        Output NetCDF file.
+
+    Returns
+    -------
+    pathlib.Path
+        The path written.
+
+    Raises
+    ------
+    TypeError
+        If ``ds`` is not an xarray.Dataset.
+    """
     if not isinstance(ds, xr.Dataset):
         raise TypeError(f"expected an xarray.Dataset, got {type(ds).__name__}")
     return _write_atomically(path, lambda tmp: _io.save_netcdf(ds, tmp))
 
 
 def load_features(path) -> xr.Dataset:
-    """Load a feature table written by :func:`save_features` (or :func:`run_cohort`)."""
+    """Load a feature table written by :func:`save_features` (or :func:`run_cohort`).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        NetCDF file.
+
+    Returns
+    -------
+    xarray.Dataset
+        The feature table, along ``session``.
+
+    Raises
+    ------
+    ValueError
+        If the file has no ``session`` dimension.
+    """
     ds = _io.load_netcdf(path)
     if "session" not in ds.dims:
         raise ValueError(f"{path}: not a cohort feature table (no 'session' dimension)")

@@ -147,7 +147,30 @@ class _Dask:
 
 
 def backend(scheduler, workers: int | None):
-    """The back end for a ``scheduler`` argument of :func:`run_cohort` (see there)."""
+    """The back end for a ``scheduler`` argument of :func:`run_cohort` (see there).
+
+    Parameters
+    ----------
+    scheduler : None, str or distributed.Client
+        ``None``: serial, or a process pool when ``workers > 1``; ``"processes"``: a
+        process pool; ``"dask"``: a local Dask cluster (one process per worker); a
+        scheduler address ``"tcp://host:port"`` or a ``distributed.Client``: that
+        Dask scheduler (a given Client is not closed by the back end).
+    workers : int, optional
+        Number of worker processes (at least 1); default the CPU count for
+        ``"processes"`` and ``"dask"``, serial for ``None``.
+
+    Returns
+    -------
+    object
+        Back end with ``name``, ``submit(fn, *args)``, ``as_completed(futures)`` and
+        ``close()``.
+
+    Raises
+    ------
+    ValueError
+        If ``workers`` is not a positive integer or ``scheduler`` is not recognised.
+    """
     if workers is not None and (isinstance(workers, bool) or int(workers) != workers):
         raise ValueError(f"workers must be a positive integer, got {workers!r}")
     if workers is not None and workers < 1:

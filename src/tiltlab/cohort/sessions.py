@@ -111,7 +111,20 @@ def _options(text: str, reader: str, where: str) -> dict[str, Any]:
 
 
 def session_path(file, root) -> Path:
-    """``file`` if absolute, else ``root / file``."""
+    """``file`` if absolute, else ``root / file``.
+
+    Parameters
+    ----------
+    file : str or os.PathLike
+        File path from a manifest (``~`` expanded).
+    root : str or os.PathLike
+        Directory that relative paths are resolved against.
+
+    Returns
+    -------
+    pathlib.Path
+        The resolved path.
+    """
     p = Path(str(file)).expanduser()
     return p if p.is_absolute() else Path(root) / p
 
@@ -177,6 +190,25 @@ def load_calibration(row: Mapping[str, Any], root) -> xr.Dataset | None:
 
     ``.nc`` files are read with :func:`tiltlab.io.load_netcdf` (validated), ``.csv``
     files with :func:`tiltlab.io.read_fayat_tumble`.
+
+    Parameters
+    ----------
+    row : Mapping
+        Manifest row; its ``calibration`` entry names the file (empty or ``"nan"``: no
+        calibration) and its ``reader_options`` (a Mapping or a JSON string) may set
+        ``check_units`` to False.
+    root : str or os.PathLike
+        Directory that a relative ``calibration`` path is resolved against.
+
+    Returns
+    -------
+    xarray.Dataset or None
+        The tumble-test Recording, or None when the row names no calibration.
+
+    Raises
+    ------
+    ManifestError
+        If the calibration file is neither ``.nc`` nor ``.csv``.
     """
     cal = str(row.get("calibration", "") or "").strip()
     if not cal or cal == "nan":

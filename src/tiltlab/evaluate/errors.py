@@ -215,7 +215,20 @@ def broad_errors(
 
 
 def tilt_rmse(q_est, rec: xr.Dataset) -> float:
-    """Inclination RMSE (degrees) over BROAD's movement samples: a ``score_fn`` for :func:`grid_search`."""
+    """Inclination RMSE (degrees) over BROAD's movement samples: a ``score_fn`` for :func:`grid_search`.
+
+    Parameters
+    ----------
+    q_est : xarray.DataArray or array_like, shape (N, 4)
+        Estimated unit quaternions (w, x, y, z), one per sample of ``rec``.
+    rec : xarray.Dataset
+        Recording with ``q_ref`` (and ``movement``).
+
+    Returns
+    -------
+    float
+        Inclination RMSE (degrees), see :func:`broad_errors`.
+    """
     return broad_errors(q_est, rec)["inclination"]
 
 
@@ -225,7 +238,27 @@ def shifted_score(
     """A ``score_fn`` for :func:`grid_search` that scores the estimate at
     several time shifts (:func:`shift_quaternions`, in samples): returns a DataArray over
     ``shift``, so that the shift is one more dimension of the grid (and of LOTO selection).
-    The same shifts must be applied to every method compared."""
+    The same shifts must be applied to every method compared.
+
+    Parameters
+    ----------
+    shifts : sequence of float
+        Time shifts (samples, fractional allowed); non-empty and finite.
+    score_fn : callable, optional
+        ``score_fn(q_est, rec) -> float`` applied to each shifted estimate; default
+        :func:`tilt_rmse` (degrees).
+
+    Returns
+    -------
+    callable
+        ``score(q_est, rec) -> xarray.DataArray`` over the ``shift`` dimension (same
+        units as ``score_fn``).
+
+    Raises
+    ------
+    ValueError
+        If ``shifts`` is empty or holds a non-finite value.
+    """
     sh = np.asarray(shifts, dtype=float).ravel()
     if sh.size == 0 or not np.all(np.isfinite(sh)):
         raise ValueError("shifts must be a non-empty sequence of finite numbers")
@@ -243,7 +276,26 @@ def shifted_score(
 
 def error_stats(errors, mask=None) -> dict[str, float]:
     """Table-1 statistics (mean, std, median, Q25, Q75, Q95) of finite errors, plus ``n``
-    and ``rmse``; ``mask`` selects samples. NaN statistics when nothing is selected."""
+    and ``rmse``; ``mask`` selects samples. NaN statistics when nothing is selected.
+
+    Parameters
+    ----------
+    errors : array_like
+        Errors (any shape, flattened; e.g. degrees); non-finite values are ignored.
+    mask : array_like of bool, optional
+        Samples to keep, same number of samples as ``errors``; default all.
+
+    Returns
+    -------
+    dict
+        ``mean``, ``std`` (ddof=1; 0 for a single value), ``median``, ``q25``, ``q75``,
+        ``q95`` and ``rmse`` (units of ``errors``), and ``n`` (samples used).
+
+    Raises
+    ------
+    ValueError
+        If ``mask`` and ``errors`` have different numbers of samples.
+    """
     e = np.asarray(errors, dtype=float).ravel()
     if mask is not None:
         m = np.asarray(mask, dtype=bool).ravel()
@@ -388,6 +440,17 @@ def state_scores(
         directions (time, axis)) and a boolean ``state`` variable (True = immobile).
     stat : str
         One of :data:`STATISTICS` or ``"rmse"``.
+
+    Returns
+    -------
+    xarray.DataArray (state,)
+        The statistic of the tilt errors (degrees) for ``state`` =
+        immobile, moving, all.
+
+    Raises
+    ------
+    ValueError
+        If ``rec`` lacks ``ref`` or ``state``, or ``stat`` is unknown.
     """
     if ref not in rec or state not in rec:
         raise ValueError(f"recording needs variables {ref!r} and {state!r}")
@@ -464,7 +527,25 @@ def binned_by_speed(errors: Mapping[str, Any], speed, edges) -> xr.Dataset:
 
 
 def ecdf(values) -> tuple[np.ndarray, np.ndarray]:
-    """Empirical CDF of the finite values: sorted ``x`` and ``F(x) = i / n`` (i = 1…n)."""
+    """Empirical CDF of the finite values: sorted ``x`` and ``F(x) = i / n`` (i = 1…n).
+
+    Parameters
+    ----------
+    values : array_like
+        Values (any shape, flattened); non-finite values are ignored.
+
+    Returns
+    -------
+    x : numpy.ndarray (n,)
+        Sorted finite values (units of ``values``).
+    F : numpy.ndarray (n,)
+        Cumulative fractions ``i / n``, i = 1…n.
+
+    Raises
+    ------
+    ValueError
+        If there is no finite value.
+    """
     v = np.asarray(values, dtype=float).ravel()
     v = np.sort(v[np.isfinite(v)])
     if v.size == 0:

@@ -69,7 +69,25 @@ BASELINES: dict[str, tuple[str, bool]] = {
 
 def folds(trials: Iterable[int], n_folds: int) -> list[list[int]]:
     """Deal BROAD trials to ``n_folds`` test folds, undisturbed and disturbed separately
-    (in trial order), so that each fold has both kinds."""
+    (in trial order), so that each fold has both kinds.
+
+    Parameters
+    ----------
+    trials : iterable of int
+        BROAD trial numbers.
+    n_folds : int
+        Number of folds, in ``2 .. len(trials)``.
+
+    Returns
+    -------
+    list of list of int
+        The test trials of each fold, each sorted.
+
+    Raises
+    ------
+    ValueError
+        If ``n_folds`` is out of range.
+    """
     groups = datasets.broad_trial_groups()
     trials = sorted(int(t) for t in trials)
     if n_folds < 2 or n_folds > len(trials):
@@ -86,7 +104,21 @@ def folds(trials: Iterable[int], n_folds: int) -> list[list[int]]:
 
 def trial_errors(q, recording) -> dict[str, float]:
     """QAE (Eq. 4; mean and median, degrees) and BROAD's RMSEs of an estimate, over the
-    movement samples with a valid reference."""
+    movement samples with a valid reference.
+
+    Parameters
+    ----------
+    q : array_like (N, 4)
+        Estimated unit quaternions (w, x, y, z), one per sample of ``recording``.
+    recording : xarray.Dataset
+        BROAD trial Recording with ``q_ref`` and ``movement``.
+
+    Returns
+    -------
+    dict
+        ``qae_mean`` and ``qae_median`` (degrees), and BROAD's ``inclination``,
+        ``heading`` and ``total`` RMSEs (degrees).
+    """
     e = evaluate.broad_errors(q, recording)
     q = np.asarray(q, float)
     ref = recording["q_ref"].transpose("time", "quat").values
@@ -114,6 +146,23 @@ def cross_validate(
 ) -> pd.DataFrame:
     """Train one model per variant and fold, evaluate it on its held-out trials and
     write the files listed in the module docstring to ``out``.
+
+    Parameters
+    ----------
+    out : str or pathlib.Path
+        Output folder (created if needed).
+    trials : sequence of int, optional
+        BROAD trial numbers; default all of them.
+    n_folds : int, default 5
+        Number of folds (:func:`folds`).
+    variants : sequence of str, default ("quaternion", "gain")
+        Model variants (``TrainConfig.variant``) to train.
+    config : TrainConfig, optional
+        Base configuration, default ``TrainConfig()``; ``variant`` is set per variant.
+    command : str, default ""
+        Command line recorded in the output files.
+    progress : callable, default print
+        Called with a progress message (str).
 
     Returns
     -------
@@ -214,6 +263,24 @@ def ablate(
     training trials (``epochs`` epochs) and evaluate it, in closed loop, on that fold's
     test trials. Writes ``ablation.json`` to ``out``.
 
+    Parameters
+    ----------
+    out : str or pathlib.Path
+        Output folder (created if needed).
+    fold : int, default 0
+        Index of the test fold, in ``0 .. n_folds - 1``.
+    n_folds : int, default 5
+        Number of folds the BROAD trials are dealt to (:func:`folds`).
+    epochs : int, default 2
+        Training epochs of each ablation.
+    config : TrainConfig, optional
+        Base configuration (default ``TrainConfig()``); ``epochs`` and the
+        ``"quaternion"`` variant override it, then each :data:`ABLATIONS` entry.
+    command : str, default ""
+        Command line recorded in ``ablation.json``.
+    progress : callable, default print
+        Called with a progress message (str).
+
     Returns
     -------
     pandas.DataFrame
@@ -280,6 +347,16 @@ def check_files(folder: str | Path) -> dict[str, str]:
     blank lines are ignored and the ``*`` binary marker accepted; an empty file or a
     malformed line is an error naming the line.
 
+    Parameters
+    ----------
+    folder : str or pathlib.Path
+        Folder holding ``SHA256SUMS`` and the files it lists.
+
+    Returns
+    -------
+    dict
+        File name (str) -> SHA-256 hex digest (str) of every verified file.
+
     Raises
     ------
     tiltlab.io.IntegrityError
@@ -310,7 +387,25 @@ def check_files(folder: str | Path) -> dict[str, str]:
 
 def learned_estimate(recording, weights: str | Path):
     """Closed-loop estimate of a Recording by the model in ``weights`` (a ``.pt`` file
-    written by :func:`save`), labelled like :func:`tiltlab.filters.estimate`."""
+    written by :func:`save`), labelled like :func:`tiltlab.filters.estimate`.
+
+    Parameters
+    ----------
+    recording : xarray.Dataset
+        Recording to estimate, at the sampling rate the model was trained at.
+    weights : str or pathlib.Path
+        Model file (``.pt``) written by :func:`save`.
+
+    Returns
+    -------
+    xarray.DataArray (time, quat)
+        Unit quaternions (w, x, y, z), sensor to world (ENU).
+
+    Raises
+    ------
+    ValueError
+        If the recording's sampling rate differs from the model's.
+    """
     from ..filters import recordings as _rec
 
     model, cfg, fs = load(weights)

@@ -45,7 +45,18 @@ TOTALS = {"L1": "sum of |L_i| (Eq. 10)", "L2": "sqrt of the sum of L_i^2 (Eq. 11
 
 
 def qmul(p: torch.Tensor, q: torch.Tensor) -> torch.Tensor:
-    """Hamilton product of scalar-first quaternions, broadcast over leading dims."""
+    r"""Hamilton product of scalar-first quaternions, broadcast over leading dims.
+
+    Parameters
+    ----------
+    p, q : torch.Tensor (..., 4)
+        Quaternions (w, x, y, z), scalar first; leading dimensions broadcast.
+
+    Returns
+    -------
+    torch.Tensor (..., 4)
+        The product :math:`p \otimes q` (w, x, y, z).
+    """
     pw, px, py, pz = p.unbind(-1)
     qw, qx, qy, qz = q.unbind(-1)
     return torch.stack(
@@ -64,13 +75,47 @@ def _conj(q: torch.Tensor) -> torch.Tensor:
 
 
 def qae(q_ref: torch.Tensor, q_est: torch.Tensor) -> torch.Tensor:
-    """Quaternion angle error (Eq. 4), radians, per sample."""
+    """Quaternion angle error (Eq. 4), radians, per sample.
+
+    Parameters
+    ----------
+    q_ref : torch.Tensor (N, 4)
+        Reference unit quaternions (w, x, y, z).
+    q_est : torch.Tensor (N, 4)
+        Estimated unit quaternions (w, x, y, z), same shape as ``q_ref``.
+
+    Returns
+    -------
+    torch.Tensor (N,)
+        Rotation angle between each pair (rad), in [0, π]; sign-invariant.
+    """
     d = (q_ref * q_est).sum(-1)
     return torch.arccos(torch.clamp(2.0 * d * d - 1.0, -1.0, 1.0))
 
 
 def sample_loss(q_ref: torch.Tensor, q_est: torch.Tensor, kind: str) -> torch.Tensor:
-    """Per-sample loss ``kind`` (a key of :data:`LOSSES`)."""
+    """Per-sample loss ``kind`` (a key of :data:`LOSSES`).
+
+    Parameters
+    ----------
+    q_ref : torch.Tensor (N, 4)
+        Reference unit quaternions (w, x, y, z).
+    q_est : torch.Tensor (N, 4)
+        Estimated unit quaternions (w, x, y, z), same shape as ``q_ref``.
+    kind : str
+        Loss name, one of ``"acos"``, ``"acos_taylor1"``, ``"acos_taylor2"``,
+        ``"l1_product"``, ``"l2_product"`` (see :data:`LOSSES`).
+
+    Returns
+    -------
+    torch.Tensor (N,)
+        Per-sample loss (rad for the ``"acos"`` forms; dimensionless norms otherwise).
+
+    Raises
+    ------
+    ValueError
+        If ``kind`` is not a key of :data:`LOSSES`.
+    """
     if kind not in LOSSES:
         raise ValueError(f"loss must be one of {sorted(LOSSES)}, got {kind!r}")
     if kind.startswith("acos"):
@@ -91,7 +136,26 @@ def sample_loss(q_ref: torch.Tensor, q_est: torch.Tensor, kind: str) -> torch.Te
 
 
 def total_loss(per_sample: torch.Tensor, total: str) -> torch.Tensor:
-    """Total of Eq. 10 (``"L1"``) or Eq. 11 (``"L2"``) over a batch."""
+    """Total of Eq. 10 (``"L1"``) or Eq. 11 (``"L2"``) over a batch.
+
+    Parameters
+    ----------
+    per_sample : torch.Tensor (N,)
+        Per-sample losses, e.g. from :func:`sample_loss`.
+    total : {"L1", "L2"}
+        ``"L1"``: sum of absolute values (Eq. 10); ``"L2"``: square root of the sum of
+        squares (Eq. 11, with 1e-12 added under the root for a finite gradient).
+
+    Returns
+    -------
+    torch.Tensor
+        Scalar (0-d) total loss.
+
+    Raises
+    ------
+    ValueError
+        If ``total`` is not a key of :data:`TOTALS`.
+    """
     if total == "L1":
         return per_sample.abs().sum()
     if total == "L2":

@@ -65,5 +65,22 @@ class Lookahead:
 
 
 def radam_lookahead(params, *, lr: float, k: int = 5, alpha: float = 0.5) -> Lookahead:
-    """``Lookahead(torch.optim.RAdam(params, lr=lr), k=k, alpha=alpha)``."""
+    """``Lookahead(torch.optim.RAdam(params, lr=lr), k=k, alpha=alpha)``.
+
+    Parameters
+    ----------
+    params : iterable of torch.Tensor or dict
+        Parameters (or parameter groups) to optimise, as for ``torch.optim.RAdam``.
+    lr : float
+        Learning rate of the inner RAdam optimiser.
+    k : int, default 5
+        Lookahead synchronisation period (inner steps).
+    alpha : float, default 0.5
+        Slow-weight step size, in (0, 1].
+
+    Returns
+    -------
+    Lookahead
+        The Lookahead optimiser wrapping RAdam.
+    """
     return Lookahead(torch.optim.RAdam(params, lr=lr), k=k, alpha=alpha)

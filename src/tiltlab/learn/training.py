@@ -128,6 +128,21 @@ class TrainConfig:
 
 
 def build_model(config: TrainConfig, fs: float) -> OrientationCNN:
+    """A new (untrained) network for a configuration and sampling rate.
+
+    Parameters
+    ----------
+    config : TrainConfig
+        Architecture: variant, channels, kernel, dilations, activations and window
+        duration ``window_s`` (s).
+    fs : float
+        Sampling rate (Hz); the window is ``round(window_s * fs)`` samples.
+
+    Returns
+    -------
+    OrientationCNN
+        The network, with freshly initialised weights.
+    """
     return OrientationCNN(
         config.window(fs),
         variant=config.variant,
@@ -349,6 +364,20 @@ def run(model: OrientationCNN, seq: Sequence, config: TrainConfig) -> np.ndarray
     the integrator started from its own estimate there. Windows are evaluated in
     blocks of :math:`T` consecutive outputs, one batch per block.
 
+    Parameters
+    ----------
+    model : OrientationCNN
+        Trained network (set to evaluation mode).
+    seq : Sequence
+        Arrays of the recording (:func:`tiltlab.learn.data.sequence`).
+    config : TrainConfig
+        Configuration the model was trained with (its window duration, s).
+
+    Returns
+    -------
+    numpy.ndarray (N, 4)
+        Unit quaternions (w, x, y, z), float64, one per sample of ``seq``.
+
     Raises
     ------
     ValueError
@@ -386,7 +415,18 @@ def run(model: OrientationCNN, seq: Sequence, config: TrainConfig) -> np.ndarray
 
 
 def sha256(path: str | Path) -> str:
-    """SHA-256 of a file (hex), read once in 1 MiB blocks."""
+    """SHA-256 of a file (hex), read once in 1 MiB blocks.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        File to hash.
+
+    Returns
+    -------
+    str
+        Hex digest (64 lower-case characters).
+    """
     h = hashlib.sha256()
     with open(path, "rb") as f:
         for chunk in iter(lambda: f.read(1 << 20), b""):
@@ -405,6 +445,17 @@ def read_sums(path: str | Path) -> dict[str, str]:
     Each line is 64 hex digits, a space, then a space (text mode) or ``*`` (binary
     mode), then the file name, relative to the file's folder. Blank lines are
     ignored; anything else is an error.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The ``SHA256SUMS`` file.
+
+    Returns
+    -------
+    dict
+        File name (str, relative to the file's folder) -> SHA-256 hex digest (str,
+        lower case).
 
     Raises
     ------
@@ -478,7 +529,24 @@ def save(
     The file also holds the SHA-256 of its content (configuration, ``fs``, every
     tensor), which :func:`load` checks; the returned sha256 of the whole file is the
     one to list in the folder's ``SHA256SUMS`` (:func:`tiltlab.learn.cross_validate`
-    does)."""
+    does).
+
+    Parameters
+    ----------
+    model : OrientationCNN
+        Network whose weights are written.
+    config : TrainConfig
+        Its training configuration, stored with the weights.
+    fs : float
+        Sampling rate (Hz) it was trained at.
+    path : str or pathlib.Path
+        Output ``.pt`` file (its folder is created if needed).
+
+    Returns
+    -------
+    str
+        SHA-256 hex digest of the written file.
+    """
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     blob = {"state": model.state_dict(), "config": config.to_dict(), "fs": float(fs)}
@@ -507,6 +575,15 @@ def load(
     verify : bool
         Check the recorded checksums (default). ``verify=False`` loads a file that
         fails them, e.g. to inspect it; never use such a model for results.
+
+    Returns
+    -------
+    model : OrientationCNN
+        The network, in evaluation mode.
+    config : TrainConfig
+        Its training configuration.
+    fs : float
+        Sampling rate (Hz) it was trained at.
 
     Raises
     ------

@@ -262,6 +262,26 @@ def session_plan(
     Per-animal draws use ``SeedSequence([seed, animal])`` and per-session draws
     ``SeedSequence([seed, animal, session])``: a session's content does not depend on
     the order in which sessions are simulated, nor on the number of workers.
+
+    Parameters
+    ----------
+    design : CohortDesign
+        Cohort design: groups, time points, planted effects and their spreads.
+    seed : int
+        Root seed of the cohort.
+    duration_s : float
+        Duration of each session (s), recorded in the table.
+    fs : float
+        Sampling rate (Hz), recorded in the table.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per (animal, time point): ``subject``, ``group``, ``timepoint``,
+        ``hours``, ``session``, ``file``, ``calibration``, seeds and the planted values
+        (``immobility_planted`` and ``mobility_planted`` as fractions/factors,
+        ``tilt_deg_planted`` and ``pitch_deg_planted`` in degrees,
+        ``circling_cpm_planted`` in circles per minute, ...).
     """
     rows = []
     sgn = 1.0 if design.lesion_side == "left" else -1.0
@@ -610,7 +630,26 @@ class Cohort:
 
 def load_cohort(path) -> Cohort:
     """Read a cohort directory (``sessions.csv`` with columns subject, group,
-    timepoint, hours, file; optional ``truth.csv`` and ``design.json``)."""
+    timepoint, hours, file; optional ``truth.csv`` and ``design.json``).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        Cohort directory.
+
+    Returns
+    -------
+    Cohort
+        ``path``, ``sessions`` (DataFrame), ``truth`` (DataFrame or None) and
+        ``design`` (dict, empty without ``design.json``).
+
+    Raises
+    ------
+    FileNotFoundError
+        If there is no ``sessions.csv`` or a session file is missing.
+    ValueError
+        If ``sessions.csv`` lacks a required column.
+    """
     path = Path(path)
     table = path / "sessions.csv"
     if not table.is_file():
@@ -638,5 +677,18 @@ def load_cohort(path) -> Cohort:
 def iter_sessions(
     path, *, validate: bool = True
 ) -> Iterator[tuple[pd.Series, xr.Dataset]]:
-    """Shortcut for ``load_cohort(path).iter_sessions()``."""
+    """Shortcut for ``load_cohort(path).iter_sessions()``.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        Cohort directory (see :func:`load_cohort`).
+    validate : bool, default True
+        Validate each Recording when it is read.
+
+    Returns
+    -------
+    iterator of (pandas.Series, xarray.Dataset)
+        ``(row, recording)`` for every session, in table order.
+    """
     return load_cohort(path).iter_sessions(validate=validate)

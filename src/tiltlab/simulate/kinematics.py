@@ -280,6 +280,18 @@ def target_tilt(pitch, roll) -> np.ndarray:
     ``pitch`` β (rad) is nose-down, ``roll`` γ (rad) right-ear-down. This is the gravity-up
     direction in the sensor frame after a pitch about world y then a roll about sensor x,
     ``R = R_y(β) R_x(γ)``.
+
+    Parameters
+    ----------
+    pitch : float or array_like
+        Pitch β (rad), nose-down positive.
+    roll : float or array_like
+        Roll γ (rad), right-ear-down positive; broadcast with ``pitch``.
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., 3)
+        Unit tilt vectors (sensor frame), one per broadcast (pitch, roll) pair.
     """
     pitch, roll = np.asarray(pitch, float), np.asarray(roll, float)
     return np.stack(
@@ -334,6 +346,16 @@ def behaviour_bouts(
     proportional to ``state_weights / state_mean_s`` so that their shares of active
     time follow ``state_weights``; the last state is truncated at the episode end.
     The expected fraction of immobile time is therefore ``params.immobility_fraction``.
+
+    Parameters
+    ----------
+    duration_s : float
+        Duration (s) to fill with bouts.
+    params : BehaviourParams
+        Behaviour parameters (immobility fraction, mobility, bout durations, state
+        weights, circling rate ...).
+    rng : numpy.random.Generator
+        Random source.
 
     Returns
     -------

@@ -222,7 +222,36 @@ def simulate_mocap_session(
 ) -> tuple[xr.Dataset, xr.Dataset]:
     """A concurrent IMU + motion-capture session (Fayat §2.6): returns the IMU
     Recording (with a boolean ``sync`` variable marking TTL-bearing samples) and the
-    mocap Dataset of :func:`mocap_markers`."""
+    mocap Dataset of :func:`mocap_markers`.
+
+    Parameters
+    ----------
+    duration_s : float
+        Session duration (s).
+    fs : float, default 300.0
+        IMU sampling rate (Hz).
+    seed : int, SeedSequence or None
+        Seed of the single random generator of the session (None: fresh entropy).
+    behaviour : BehaviourParams, optional
+        Behaviour of the simulated rat; default ``BehaviourParams()``.
+    sensor : SensorModel, optional
+        IMU model; its ``None`` errors are drawn.
+    lesion : Lesion, optional
+        Unilateral vestibular deficit; default none.
+    support : MarkerSupport, optional
+        Rigid marker support geometry.
+    **mocap_kwargs
+        Passed to :func:`mocap_markers` (``noise_mm``, ``occlusion_rate``,
+        ``reflection_rate``, ``slip_fraction``, ``clock_jitter``, ``ttl_every`` ...).
+
+    Returns
+    -------
+    rec : xarray.Dataset
+        IMU Recording (``acc`` g, ``gyr`` °/s, ``mag`` µT, truth ``q_ref`` ...) with
+        the boolean ``sync`` variable.
+    mocap : xarray.Dataset
+        Motion-capture Dataset of :func:`mocap_markers` (markers in mm).
+    """
     rng = np.random.default_rng(seed)
     motion = head_kinematics(
         duration_s, fs, behaviour=behaviour, lesion=lesion, rng=rng

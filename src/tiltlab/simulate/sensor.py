@@ -214,6 +214,18 @@ def draw_sensor(sensor: SensorModel | None, rng: np.random.Generator) -> SensorM
     scale errors N(0, 1 %), cross-axis N(0, 0.5 %), temperature coefficients
     N(0, 0.5 mg/°C) and N(0, 0.15 °/s/°C), temperature warming from U(27, 30) °C to
     U(31, 34) °C, hard iron N(0, 15 µT), soft iron I + symmetric N(0, 3 %).
+
+    Parameters
+    ----------
+    sensor : SensorModel or None
+        Sensor model whose given errors are kept; None: ``SensorModel()``.
+    rng : numpy.random.Generator
+        Random source of the draws.
+
+    Returns
+    -------
+    SensorModel
+        A new model with every error and both temperatures (°C) set.
     """
     s = sensor or SensorModel()
 
@@ -477,6 +489,17 @@ def magnetometer_readings(
     :math:`W R(q)^\top m_w + h + n` with soft iron :math:`W`, hard iron :math:`h` and white
     noise :math:`n`, quantised to the AK8963's 0.15 µT when ``sensor.quantize``.
 
+    Parameters
+    ----------
+    q : array_like, shape (N, 4)
+        True orientations, unit quaternions (w, x, y, z), sensor to world (ENU).
+    sensor : SensorModel
+        Drawn sensor (no ``None`` errors): ``field_uT`` (µT), ``dip_deg`` (degrees),
+        ``mag_soft_iron`` (3, 3), ``mag_hard_iron`` (µT), ``mag_noise_uT`` (µT, white
+        noise standard deviation) and ``quantize``.
+    rng : numpy.random.Generator
+        Random source of the noise.
+
     Returns
     -------
     mag : numpy.ndarray, shape (N, 3)
@@ -498,7 +521,20 @@ def magnetometer_readings(
 
 
 def true_sensor_values(q, a_lin_g) -> np.ndarray:
-    r"""True accelerometer reading (g): :math:`R(q)^\top (e_z + a_{lin})` with ``a_lin`` in g, world frame."""
+    r"""True accelerometer reading (g): :math:`R(q)^\top (e_z + a_{lin})` with ``a_lin`` in g, world frame.
+
+    Parameters
+    ----------
+    q : array_like, shape (N, 4)
+        Orientations, unit quaternions (w, x, y, z), sensor to world.
+    a_lin_g : array_like, shape (N, 3)
+        Linear acceleration of the sensor (g), world frame, z up.
+
+    Returns
+    -------
+    numpy.ndarray, shape (N, 3)
+        Error-free specific force (g) in the sensor frame.
+    """
     a = np.asarray(a_lin_g, float)
     return _quat.rotate_inverse(q, a + np.array([0.0, 0.0, 1.0]))
 
@@ -517,6 +553,25 @@ def recording_from_motion(
     truth ``q_ref``, ``a_lin`` (g, world frame), ``state`` (int8, legend in
     ``flag_values``/``flag_meanings``) and, with ``keep_true``, ``acc_true``, ``gyr_true``
     and ``pos`` (m, world frame). True sensor errors are in ``true_*`` attrs.
+
+    Parameters
+    ----------
+    motion : TrueMotion
+        True motion: orientations, angular velocity (rad/s), linear acceleration
+        (m/s², world frame), positions (m), states, at ``motion.fs`` (Hz).
+    rng : numpy.random.Generator
+        Random source of the sensor errors and noise.
+    sensor : SensorModel, optional
+        Sensor model; its ``None`` errors are drawn (default ``SensorModel()``).
+    keep_true : bool, default True
+        Also store ``acc_true``, ``gyr_true`` and ``pos``.
+    attrs : dict, optional
+        Extra attributes of the Recording (override the defaults).
+
+    Returns
+    -------
+    xarray.Dataset
+        The validated Recording.
     """
     fs = motion.fs
     a_lin_g = motion.a_lin / G0

@@ -38,7 +38,20 @@ __all__ = ["stage_angles", "stage_quaternion", "tumble_test", "zoh_angular_veloc
 
 def zoh_angular_velocity(q, fs: float) -> np.ndarray:
     r"""Angular velocity (rad/s, sensor frame) whose zero-order-hold integral is ``q``:
-    :math:`\omega_k = f_s\,\mathrm{Log}(q_k^* \otimes q_{k+1})`, last sample 0."""
+    :math:`\omega_k = f_s\,\mathrm{Log}(q_k^* \otimes q_{k+1})`, last sample 0.
+
+    Parameters
+    ----------
+    q : array_like (N, 4)
+        Unit quaternions (w, x, y, z), sensor to world, one per sample.
+    fs : float
+        Sampling rate (Hz).
+
+    Returns
+    -------
+    numpy.ndarray (N, 3)
+        Angular velocity (rad/s) in the sensor frame; the last row is 0.
+    """
     q = np.asarray(q, float)
     w = np.zeros((q.shape[0], 3))
     if q.shape[0] > 1:

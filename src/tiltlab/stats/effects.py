@@ -255,6 +255,18 @@ def rank_biserial(x, y, *, conf_level: float = 0.95) -> Interval:
     Same sign convention as ``pingouin.mwu``'s ``RBC`` (positive when ``x`` tends to
     be larger); the interval is :math:`2\,[p_L, p_U] - 1` from
     :func:`prob_superiority`.
+
+    Parameters
+    ----------
+    x, y : array_like
+        Independent samples.
+    conf_level : float, default 0.95
+        Confidence level of the interval, in (0, 1).
+
+    Returns
+    -------
+    Interval
+        Estimate and interval ends, in [-1, 1].
     """
     ps = prob_superiority(x, y, conf_level=conf_level)
     return Interval(2 * ps.estimate - 1, 2 * ps.low - 1, 2 * ps.high - 1, ps.conf_level)
@@ -275,6 +287,26 @@ def paired_rank_biserial(x, y=None, *, zero_method: str = "wilcox") -> float:
     Positive when ``x - y`` tends to be positive; equals ``pingouin.wilcoxon``'s
     ``RBC`` for ``alternative="greater"`` or ``"two-sided"`` (pingouin flips its sign
     for ``"less"``). NaN when every difference is zero.
+
+    Parameters
+    ----------
+    x : array_like (n,)
+        Values, or the paired differences themselves when ``y`` is None.
+    y : array_like (n,), optional
+        Paired values, same length as ``x``; the differences are ``x - y``.
+    zero_method : {"wilcox", "pratt"}, default "wilcox"
+        Zero differences: ``"wilcox"`` drops them before ranking; ``"pratt"`` ranks them
+        with the others and then drops them.
+
+    Returns
+    -------
+    float
+        Correlation in [-1, 1]; NaN when every difference is zero.
+
+    Raises
+    ------
+    ValueError
+        If ``zero_method`` is not one of ``"wilcox"``, ``"pratt"``.
     """
     if zero_method not in ZERO_METHODS:
         raise ValueError(
@@ -297,6 +329,20 @@ def paired_prob_superiority(x, y=None, *, conf_level: float = 0.95) -> Interval:
     :math:`n` pairs,
     :math:`\big(\hat p + \frac{z^2}{2n} \pm z\sqrt{\hat p(1-\hat p)/n + z^2/4n^2}\big)
     / (1 + z^2/n)`.
+
+    Parameters
+    ----------
+    x : array_like (n,)
+        Values, or the paired differences :math:`D` themselves when ``y`` is None.
+    y : array_like (n,), optional
+        Paired values, same length as ``x``; :math:`D = x - y`.
+    conf_level : float, default 0.95
+        Confidence level of the Wilson interval, in (0, 1).
+
+    Returns
+    -------
+    Interval
+        Estimate :math:`\hat p` and interval ends, clipped to [0, 1].
 
     References
     ----------

@@ -260,6 +260,16 @@ def mwu_null_distribution(n1: int, n2: int) -> np.ndarray:
 def signed_rank_null_distribution(n: int) -> np.ndarray:
     r"""Exact null probabilities :math:`P(T^+ = t)`, :math:`t = 0,\dots,n(n+1)/2`.
 
+    Parameters
+    ----------
+    n : int
+        Number of non-zero differences (no ties), at least 1.
+
+    Returns
+    -------
+    numpy.ndarray (n(n+1)/2 + 1,)
+        :math:`P(T^+ = t)` for :math:`t = 0, 1, \dots, n(n+1)/2`; sums to 1.
+
     Raises
     ------
     ValueError
@@ -609,6 +619,11 @@ def exact_p_lattice(n1: int, n2: int) -> pd.DataFrame:
 
 def signed_rank_p_lattice(n: int) -> pd.DataFrame:
     r"""The attainable exact one-sided signed-rank p-values for ``n`` differences.
+
+    Parameters
+    ----------
+    n : int
+        Number of non-zero differences (no ties), at least 1.
 
     Returns
     -------

@@ -153,7 +153,20 @@ def observed_shift(x, y, *, scale: float = 1.0) -> Simulator:
 
 
 def normal_shift_superiority(shift: float, sd: float = 1.0) -> float:
-    r""":math:`P(X > Y) = \Phi(\delta/(\sigma\sqrt2))` for two normal groups."""
+    r""":math:`P(X > Y) = \Phi(\delta/(\sigma\sqrt2))` for two normal groups.
+
+    Parameters
+    ----------
+    shift : float
+        Difference of the group means :math:`\delta` (units of the data).
+    sd : float, default 1.0
+        Common standard deviation :math:`\sigma` of both groups (same units), > 0.
+
+    Returns
+    -------
+    float
+        Probability of superiority :math:`P(X > Y)`, in (0, 1).
+    """
     shift = _validate.finite(shift, "shift")
     sd = _validate.positive(sd, "sd")
     return float(_st.norm.cdf(shift / (sd * math.sqrt(2))))
