@@ -101,6 +101,25 @@ def as_unit_vectors(v, name: str = "vectors", allow_nan: bool = False) -> np.nda
     ``v`` is a labelled (time, axis) DataArray, a Recording (its ``gravity`` variable), an
     (N, 3) array or a single (3,) vector; it is read with :func:`tiltlab._validate.signal`.
     Rows must be finite and non-zero; with ``allow_nan`` NaN rows stay NaN.
+
+    Parameters
+    ----------
+    v : xarray.DataArray, xarray.Dataset or array_like, shape (N, 3) or (3,)
+        Directions (any non-zero length).
+    name : str
+        Name used in error messages.
+    allow_nan : bool
+        Accept NaN rows (returned as NaN) instead of raising.
+
+    Returns
+    -------
+    ndarray, shape (N, 3)
+        Unit vectors.
+
+    Raises
+    ------
+    ValueError
+        If a row is a zero vector (or NaN/inf when not allowed).
     """
     a = _read(v, name=name, allow_nan=allow_nan).values
     bad = np.isnan(a).any(axis=1)
@@ -212,6 +231,18 @@ def to_lonlat(v) -> tuple[np.ndarray, np.ndarray]:
 
     In the rodent sensor frame (x nose, y left, z up) longitude 0 is the nose, +π/2 the
     left ear, and latitude +π/2 the dorsal axis.
+
+    Parameters
+    ----------
+    v : array_like, shape (..., 3)
+        Directions (need not be unit length).
+
+    Returns
+    -------
+    lon : ndarray, shape (...)
+        Longitude ξ (rad), in (−π, π].
+    lat : ndarray, shape (...)
+        Latitude ψ (rad), in [−π/2, π/2].
     """
     v = np.asarray(v, float)
     if v.shape[-1] != 3:
@@ -222,7 +253,20 @@ def to_lonlat(v) -> tuple[np.ndarray, np.ndarray]:
 
 
 def from_lonlat(lon, lat) -> np.ndarray:
-    """Unit vectors from longitude and latitude (rad), shape (..., 3); inverse of :func:`to_lonlat`."""
+    """Unit vectors from longitude and latitude (rad), shape (..., 3); inverse of :func:`to_lonlat`.
+
+    Parameters
+    ----------
+    lon : float or array_like
+        Longitude ξ (rad).
+    lat : float or array_like
+        Latitude ψ (rad); broadcasts with ``lon``.
+
+    Returns
+    -------
+    ndarray, shape (..., 3)
+        Unit vectors (x, y, z).
+    """
     lon, lat = np.broadcast_arrays(np.asarray(lon, float), np.asarray(lat, float))
     c = np.cos(lat)
     return np.stack([c * np.cos(lon), c * np.sin(lon), np.sin(lat)], axis=-1)
@@ -240,6 +284,16 @@ def spherical_triangle_area(a, b, c) -> np.ndarray:
     :math:`E = 2\,\mathrm{atan2}\big(|a\cdot(b\times c)|,\;1 + a\cdot b + b\cdot c + c\cdot a\big)`,
     valid for any triangle (the atan2 keeps the right quadrant when the denominator is
     negative). Inputs broadcast over leading axes; they are normalised first.
+
+    Parameters
+    ----------
+    a, b, c : array_like, shape (..., 3)
+        Corners of the triangles (normalised here; no zero vectors).
+
+    Returns
+    -------
+    ndarray, shape (...)
+        Area (sr) of each triangle.
     """
     a, b, c = (
         _validate.vectors(x, name, width=3, ndim=None, allow_nan=True)
@@ -581,6 +635,20 @@ def histogram(vectors, mesh: SphereMesh | None = None, *, weights=None) -> np.nd
     ``vectors`` is a labelled (time, axis) series, a Recording (its ``gravity``) or an
     (N, 3) array. Rows that are NaN (e.g. masked samples) are ignored; zero rows (no
     direction) and non-finite or negative ``weights`` are errors.
+
+    Parameters
+    ----------
+    vectors : xarray.DataArray, xarray.Dataset or array_like, shape (N, 3)
+        Directions (any non-zero length).
+    mesh : SphereMesh, optional
+        Facets to count in; None uses the default :func:`sphere_mesh`.
+    weights : array_like, shape (N,), optional
+        Non-negative weight of each sample; None counts samples.
+
+    Returns
+    -------
+    ndarray, shape (F,)
+        Count (or summed weight) per facet.
     """
     mesh = _check_mesh(mesh)
     sig = _read(vectors, allow_nan=True)
@@ -688,7 +756,20 @@ def _counts(m) -> np.ndarray:
 
 
 def visited(tmap, *, min_count: int = 1) -> np.ndarray:
-    """Binarised map: True for facets with at least ``min_count`` samples (Fayat Fig. 3c–d)."""
+    """Binarised map: True for facets with at least ``min_count`` samples (Fayat Fig. 3c–d).
+
+    Parameters
+    ----------
+    tmap : xarray.Dataset or array_like, shape (F,)
+        A map from :func:`tilt_map` (its ``count`` variable) or counts per facet.
+    min_count : int
+        Minimum number of samples (≥ 1) for a facet to count as visited.
+
+    Returns
+    -------
+    ndarray of bool, shape (F,)
+        True for visited facets.
+    """
     min_count = _validate.integer(min_count, "min_count", minimum=1)
     return _counts(tmap) >= min_count
 
@@ -702,6 +783,27 @@ def visited_fraction(
     fraction of facets (Fayat et al.'s measure, which weights every facet equally even
     though their areas differ by :meth:`SphereMesh.area_ratio`). An empty map (from
     :func:`tilt_map` with no valid sample) gives NaN: nothing was observed.
+
+    Parameters
+    ----------
+    tmap : xarray.Dataset or array_like, shape (F,)
+        A map from :func:`tilt_map` or counts per facet.
+    mesh : SphereMesh, optional
+        Mesh of the map; None uses the default :func:`sphere_mesh`.
+    min_count : int
+        Minimum number of samples (≥ 1) for a facet to count as visited.
+    by : {"area", "count"}
+        Weight facets by their area or equally.
+
+    Returns
+    -------
+    float
+        Visited fraction, in [0, 1]; NaN for an empty map.
+
+    Raises
+    ------
+    ValueError
+        If the map and the mesh have different numbers of facets, or ``by`` is invalid.
     """
     mesh = _check_mesh(mesh)
     if isinstance(tmap, xr.Dataset) and tmap.attrs.get("n_samples", 1) == 0:

@@ -203,6 +203,30 @@ def residence_series(
 
     ``vectors``, ``fs`` and ``times`` as in :func:`residence`. Returns ``(index, RT, NV)``.
     Cost O(N²/stride).
+
+    Parameters
+    ----------
+    vectors : xarray.DataArray, xarray.Dataset or array_like, shape (N, 3)
+        Time-ordered directions (see :func:`residence`).
+    radius : float
+        Angular radius of the caps (rad), in (0, π/2).
+    t_out : float
+        Excursions outside a cap no longer than this (s) do not end a visit.
+    fs : float, optional
+        Sampling rate (Hz) of a plain array.
+    times : array_like, shape (N,), optional
+        Sample times (s) of a plain array.
+    stride : int
+        Evaluate every ``stride``-th sample (≥ 1).
+
+    Returns
+    -------
+    index : ndarray of int, shape (ceil(N/stride),)
+        Sample indices evaluated.
+    residence : ndarray
+        Residence time RT(i) (s) of the visit containing each sample.
+    n_visits : ndarray
+        Number of visits NV(i) to the cap around each sample.
     """
     radius, t_out = _check(radius, t_out)
     stride = _validate.integer(stride, "stride", minimum=1)
@@ -220,6 +244,26 @@ def passage_times(
     ``vectors``, ``fs`` and ``times`` as in :func:`residence`; times are on the data's
     clock (its ``time`` coordinate when labelled). Interpolated along the arcs (App. C).
     A series that starts (ends) inside enters at its first (leaves at its last) sample time.
+
+    Parameters
+    ----------
+    vectors : xarray.DataArray, xarray.Dataset or array_like, shape (N, 3)
+        Time-ordered directions (see :func:`residence`).
+    centre : array_like, shape (3,)
+        Cap centre (normalised here).
+    radius : float
+        Angular radius of the cap (rad), in (0, π/2).
+    fs : float, optional
+        Sampling rate (Hz) of a plain array.
+    times : array_like, shape (N,), optional
+        Sample times (s) of a plain array.
+
+    Returns
+    -------
+    enters : ndarray
+        Entry times (s).
+    exits : ndarray
+        Exit times (s).
     """
     radius, _ = _check(radius, 0.0)
     x, t, _ = _series(vectors, fs, times)

@@ -90,6 +90,21 @@ def angle(u, v) -> np.ndarray:
 
     ``u`` and ``v`` (..., 3) broadcast; NaN rows give NaN, a zero vector (no direction)
     is an error naming ``u`` or ``v``.
+
+    Parameters
+    ----------
+    u, v : array_like, shape (..., 3)
+        Directions (any non-zero length); they broadcast.
+
+    Returns
+    -------
+    ndarray, shape (...)
+        Angle (rad), in [0, π].
+
+    Raises
+    ------
+    ValueError
+        If ``u`` or ``v`` contains a zero vector.
     """
     u = _validate.vectors(u, "u", width=3, ndim=None, allow_nan=True)
     v = _validate.vectors(v, "v", width=3, ndim=None, allow_nan=True)
@@ -133,7 +148,18 @@ _SMALL = 1e-3
 
 
 def a3(kappa) -> np.ndarray:
-    r"""Mean resultant length :math:`A_3(\kappa)=\coth\kappa-1/\kappa` of a vMF on :math:`S^2` (series for κ < 1e-3)."""
+    r"""Mean resultant length :math:`A_3(\kappa)=\coth\kappa-1/\kappa` of a vMF on :math:`S^2` (series for κ < 1e-3).
+
+    Parameters
+    ----------
+    kappa : float or array_like
+        Concentration κ ≥ 0.
+
+    Returns
+    -------
+    ndarray
+        Mean resultant length A_3(κ), in [0, 1).
+    """
     k = _kappa_array(kappa)
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         big = 1.0 / np.tanh(k) - 1.0 / k
@@ -155,6 +181,25 @@ def a3_inverse(rbar, *, tol: float = 1e-13, max_iter: int = 100) -> np.ndarray:
 
     :math:`\bar R = 0` gives 0 and :math:`\bar R = 1` gives ∞. Newton steps that leave the
     current bracket are replaced by bisection (in log κ above 1).
+
+    Parameters
+    ----------
+    rbar : float or array_like
+        Mean resultant length R̄, in [0, 1].
+    tol : float
+        Relative convergence tolerance on κ (> 0).
+    max_iter : int
+        Maximum number of Newton/bisection iterations (≥ 1).
+
+    Returns
+    -------
+    float or ndarray
+        Concentration κ ≥ 0 (a scalar for scalar ``rbar``); ∞ where R̄ = 1.
+
+    Raises
+    ------
+    ValueError
+        If ``rbar`` is outside [0, 1] or not finite.
     """
     r = np.asarray(rbar, float)
     bad = ~np.isfinite(r) | (r < 0) | (r > 1)
@@ -280,6 +325,20 @@ def vmf_logpdf(x, mu, kappa: float) -> np.ndarray:
     error), ``mu`` a non-zero 3-vector and ``kappa`` ≥ 0 finite. κ → 0 tends to the
     uniform density :math:`1/(4\pi)` smoothly (series below κ = 10⁻⁸); large κ (10⁶)
     neither overflows nor loses the normalisation.
+
+    Parameters
+    ----------
+    x : array_like, shape (..., 3)
+        Directions at which to evaluate the density (normalised here).
+    mu : array_like, shape (3,)
+        Mean direction μ (normalised here).
+    kappa : float
+        Concentration κ ≥ 0, finite.
+
+    Returns
+    -------
+    ndarray, shape (...)
+        Log density (log sr⁻¹).
     """
     x = _validate.vectors(x, "x", width=3, ndim=None, allow_nan=True)
     nx = np.linalg.norm(x, axis=-1, keepdims=True)
@@ -302,7 +361,22 @@ def vmf_logpdf(x, mu, kappa: float) -> np.ndarray:
 
 
 def vmf_pdf(x, mu, kappa: float) -> np.ndarray:
-    """vMF density (sr⁻¹), Eq. 14a."""
+    """vMF density (sr⁻¹), Eq. 14a.
+
+    Parameters
+    ----------
+    x : array_like, shape (..., 3)
+        Directions at which to evaluate the density (normalised here).
+    mu : array_like, shape (3,)
+        Mean direction μ (normalised here).
+    kappa : float
+        Concentration κ ≥ 0, finite.
+
+    Returns
+    -------
+    ndarray, shape (...)
+        Density (sr⁻¹).
+    """
     return np.exp(vmf_logpdf(x, mu, kappa))
 
 
@@ -322,6 +396,22 @@ def vmf_sample(mu, kappa: float, n: int, rng=None) -> np.ndarray:
     evaluated as :math:`1 + \operatorname{log1p}\big((1-u)\operatorname{expm1}(-2\kappa)\big)/\kappa`
     so that small κ (10⁻⁸, 10⁻³⁰⁰) gives the uniform distribution (w = 2u − 1) to
     rounding and large κ (10⁶) neither overflows nor collapses; κ = 0 is uniform.
+
+    Parameters
+    ----------
+    mu : array_like, shape (3,)
+        Mean direction μ (normalised here).
+    kappa : float
+        Concentration κ ≥ 0.
+    n : int
+        Number of draws (≥ 0).
+    rng : int, numpy.random.Generator or None
+        Seed or generator for :func:`numpy.random.default_rng`.
+
+    Returns
+    -------
+    ndarray, shape (n, 3)
+        Unit vectors.
     """
     mu = _direction(mu, "mu")
     kappa = _validate.nonnegative(kappa, "kappa")
@@ -346,6 +436,23 @@ def vmf_cap_area(kappa, level) -> np.ndarray:
     :math:`P(\mu\cdot x \ge t)=\frac{1-e^{-\kappa(1-t)}}{1-e^{-2\kappa}}`, and the cap
     area is :math:`2\pi(1-t) = -\frac{2\pi}{\kappa}\log\big(1-p(1-e^{-2\kappa})\big)`.
     κ = 0 (and its limit) gives the uniform :math:`4\pi p`, κ = ∞ (a point mass) 0.
+
+    Parameters
+    ----------
+    kappa : float or array_like
+        Concentration κ ≥ 0 (may be ∞).
+    level : float or array_like
+        Probability mass p of the cap, in (0, 1); broadcasts with ``kappa``.
+
+    Returns
+    -------
+    float or ndarray
+        Cap area (sr), in [0, 4π).
+
+    Raises
+    ------
+    ValueError
+        If ``level`` is not in (0, 1).
     """
     k = _kappa_array(kappa)
     p = np.asarray(level, float)
@@ -390,9 +497,30 @@ def vmf_bootstrap(
     (``block = round(block_s · fs)``), with ``fs`` read from the data (or given for a
     plain array; a missing or contradictory ``fs`` is an error).
 
+    Parameters
+    ----------
+    x : xarray.DataArray, xarray.Dataset or array_like, shape (N, 3)
+        Directions (normalised here), in time order for a block bootstrap.
+    weights : array_like, shape (N,), optional
+        Non-negative frequency weights; None for unweighted samples.
+    n_boot : int
+        Number of bootstrap replicates (≥ 2).
+    level : float
+        Confidence level, in (0, 1).
+    block : int
+        Block length (samples, ≥ 1); 1 is the i.i.d. bootstrap.
+    block_s : float, optional
+        Block length (s), instead of ``block``.
+    fs : float, optional
+        Sampling rate (Hz) of a plain array, needed with ``block_s``.
+    rng : int, numpy.random.Generator or None
+        Seed or generator for :func:`numpy.random.default_rng`.
+
     Returns
     -------
     ConfidenceCone
+        Fitted μ and κ, cone half-angle (rad) at ``level``, κ percentile interval,
+        ``level`` and the bootstrap angles (rad).
 
     Raises
     ------
@@ -577,6 +705,23 @@ def sagittal_angle(mu, lesion_side: str = "left") -> np.ndarray:
 
     so α > 0 means the head is tilted toward the lesioned side. :math:`|\alpha|` is
     Fayat et al.'s "angular distance to the sagittal plane" (Fig. 4c).
+
+    Parameters
+    ----------
+    mu : array_like, shape (..., 3)
+        Tilt (gravity-up) direction(s) in the sensor frame (normalised here).
+    lesion_side : {"left", "right"}
+        Side of the lesion; sets the sign s.
+
+    Returns
+    -------
+    ndarray, shape (...)
+        Signed angle α (rad), in [−π/2, π/2].
+
+    Raises
+    ------
+    ValueError
+        If ``lesion_side`` is not 'left' or 'right', or ``mu`` has a zero vector.
     """
     mu = _validate.vectors(mu, "mu", width=3, ndim=None, allow_nan=True)
     s = {"left": 1.0, "right": -1.0}.get(lesion_side)
@@ -594,6 +739,16 @@ def rotation_to_pole(point) -> np.ndarray:
 
     Rodrigues' formula; for :math:`p=-e_z` a half-turn about x. ``point`` must be a
     finite non-zero 3-vector.
+
+    Parameters
+    ----------
+    point : array_like, shape (3,)
+        Direction p to bring to the pole (normalised here).
+
+    Returns
+    -------
+    ndarray, shape (3, 3)
+        Rotation matrix R.
     """
     p = _direction(point, "point")
     ez = np.array([0.0, 0.0, 1.0])
@@ -612,6 +767,18 @@ def rotate_to_pole(vectors, baseline):
     is its distance to the baseline point. ``vectors`` of shape (..., 3), or a labelled
     (time, axis) series / a Recording (its ``gravity``), which gives a DataArray back
     with the same coordinates and attributes.
+
+    Parameters
+    ----------
+    vectors : array_like (..., 3), xarray.DataArray or xarray.Dataset
+        Directions to rotate (NaN rows stay NaN).
+    baseline : array_like, shape (3,)
+        Direction brought to the north pole (normalised here).
+
+    Returns
+    -------
+    ndarray, shape (..., 3), or xarray.DataArray
+        Rotated directions; a (time, axis) DataArray for labelled input.
     """
     R = rotation_to_pole(_direction(baseline, "baseline"))
     if isinstance(vectors, (xr.DataArray, xr.Dataset)):

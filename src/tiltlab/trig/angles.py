@@ -41,6 +41,21 @@ def wrap_angle(angle):
     A DataArray gives a DataArray with the same dims, coordinates, attributes and name
     (degrees, ``attrs["units"] == "deg"``, are wrapped to (−180, 180]); anything
     else gives an ndarray. ±inf is an error (no angle); NaN stays NaN.
+
+    Parameters
+    ----------
+    angle : float, array_like or xarray.DataArray
+        Angles (rad; a DataArray may be in degrees, ``attrs["units"] == "deg"``).
+
+    Returns
+    -------
+    ndarray or xarray.DataArray
+        Wrapped angles, in the input's units.
+
+    Raises
+    ------
+    ValueError
+        If ``angle`` holds ±inf, or a DataArray has units other than rad or deg.
     """
     if isinstance(angle, xr.DataArray):
         units = str(angle.attrs.get("units", "rad")).strip().lower()
@@ -82,6 +97,25 @@ def angles_from_quaternion(q, singular_tol: float = 1e-9) -> Orientation:
     dimension (e.g. :func:`tiltlab.filters.estimate`), which gives DataArrays with its
     ``time`` coordinate and ``fs``. Non-unit quaternions are normalised with a
     :class:`RuntimeWarning`; zero or infinite ones are an error; NaN rows give NaN.
+
+    Parameters
+    ----------
+    q : array_like (..., 4) or xarray.DataArray
+        Sensor(body)→world unit quaternions (w, x, y, z); a DataArray has a ``quat``
+        dimension (else its last dimension holds the components).
+    singular_tol : float
+        Tolerance (≥ 0) on the horizontal norm of the surge axis below which the
+        singular (surge vertical) fallback is used.
+
+    Returns
+    -------
+    Orientation
+        Azimuth, elevation and bank (rad); DataArrays for DataArray input.
+
+    Raises
+    ------
+    ValueError
+        If ``q`` has a wrong shape or holds zero or infinite quaternions.
     """
     singular_tol = _singular_tol(singular_tol)
     da = None
@@ -129,6 +163,25 @@ def angles_from_matrix(matrix, singular_tol: float = 1e-9) -> Orientation:
     non-orthonormal matrices and ±inf are errors naming it; NaN matrices give NaN. A
     DataArray whose last two dims are the 3 × 3 matrix gives DataArrays with its other
     coordinates (``time``) and ``fs``.
+
+    Parameters
+    ----------
+    matrix : array_like (..., 3, 3) or xarray.DataArray
+        Body→world rotation matrices.
+    singular_tol : float
+        Tolerance (≥ 0) on the horizontal norm of the surge axis below which the
+        singular fallback is used.
+
+    Returns
+    -------
+    Orientation
+        Azimuth, elevation and bank (rad); DataArrays for DataArray input.
+
+    Raises
+    ------
+    ValueError
+        If ``matrix`` has a wrong shape, is not numeric, holds ±inf or is not a proper
+        rotation.
     """
     singular_tol = _singular_tol(singular_tol)
     da = None

@@ -36,6 +36,19 @@ def arc(az0, el0, az1, el1) -> Arc:
     arcs. Inclinations are measured counter-clockwise from the horizontal in the
     frontal plane. Degenerate cases (ω = 0, or a heading at φ = ±π/2) give
     atan2(0, 0) = 0 for the undefined inclination.
+
+    Parameters
+    ----------
+    az0, el0 : float or array_like
+        Azimuth θ0 and elevation φ0 (rad) of the initial heading.
+    az1, el1 : float or array_like
+        Azimuth θ1 and elevation φ1 (rad) of the final heading.
+
+    Returns
+    -------
+    Arc
+        Size ω ∈ [0, π] and initial and final inclinations δ^i, δ^f (rad);
+        DataArrays (with the first labelled argument's ``time``) for labelled input.
     """
     x0, x1 = unit_vector(az0, el0), unit_vector(az1, el1)
     w = np.arctan2(np.linalg.norm(np.cross(x0, x1), axis=-1), np.sum(x0 * x1, axis=-1))
@@ -51,7 +64,22 @@ def _incl(az0, el0, az1, el1, w, q):
 
 @angle_function("inclination")
 def arc_inclination(az0, el0, az1, el1, q) -> np.ndarray:
-    """Local inclination δ̃(q), q ∈ [0, 1], of the arc (θ0, φ0) → (θ1, φ1), Eq. 7b."""
+    """Local inclination δ̃(q), q ∈ [0, 1], of the arc (θ0, φ0) → (θ1, φ1), Eq. 7b.
+
+    Parameters
+    ----------
+    az0, el0 : float or array_like
+        Azimuth θ0 and elevation φ0 (rad) of the initial heading.
+    az1, el1 : float or array_like
+        Azimuth θ1 and elevation φ1 (rad) of the final heading.
+    q : float or array_like
+        Fraction of the arc, in [0, 1] (0: start, 1: end).
+
+    Returns
+    -------
+    ndarray
+        Local inclination δ̃(q) (rad).
+    """
     return _incl(az0, el0, az1, el1, arc(az0, el0, az1, el1).size, q)
 
 
@@ -67,6 +95,24 @@ def interpolate_heading(
 
     Eq. 6a's printed form divides by tan(qω); both atan2 arguments are multiplied
     here by sin(qω) ≥ 0, which gives the same angle and is defined at q = 0.
+
+    Parameters
+    ----------
+    az0, el0 : float or array_like
+        Azimuth θ0 and elevation φ0 (rad) of the initial heading.
+    initial_inclination : float or array_like
+        Initial inclination δ^i (rad) of the arc.
+    size : float or array_like
+        Arc size ω (rad).
+    q : float or array_like
+        Fraction of the arc, in [0, 1].
+
+    Returns
+    -------
+    azimuth : ndarray
+        Azimuth θ̃(q) (rad), wrapped to (−π, π].
+    elevation : ndarray
+        Elevation φ̃(q) (rad).
     """
     s = np.asarray(q, float) * np.asarray(size, float)
     d = np.asarray(initial_inclination, float)
@@ -89,6 +135,20 @@ def great_circle_apex(az, el, inclination) -> tuple[np.ndarray, np.ndarray]:
     :math:`\hat\theta=\theta+\mathrm{sgn}(\tan\delta)\cos^{-1}(\tan\phi/\tan\hat\phi)`.
     Returns (φ̂, θ̂). Fallback: when the great circle is the horizon (φ̂ = 0) every
     point is an apex and θ̂ = θ is returned.
+
+    Parameters
+    ----------
+    az, el : float or array_like
+        Azimuth θ and elevation φ (rad) of a heading on the great circle.
+    inclination : float or array_like
+        Local inclination δ (rad) of the great circle at that heading.
+
+    Returns
+    -------
+    apex_elevation : ndarray
+        Elevation φ̂ (rad) of the apex, in [0, π/2].
+    apex_azimuth : ndarray
+        Azimuth θ̂ (rad) of the apex, wrapped to (−π, π].
     """
     az, el, d = np.broadcast_arrays(
         *(np.asarray(a, float) for a in (az, el, inclination))
@@ -110,6 +170,20 @@ def interpolate_bank(az0, el0, bank0, az1, el1, bank1, q) -> np.ndarray:
     :math:`\tilde\lambda(q)=\lambda_0+\tilde\delta(q)-\delta^i+q(\eta^i-\eta^f)` with
     :math:`\eta^i=\delta^i-\lambda_0`, :math:`\eta^f=\delta^f-\lambda_1` and the roll
     :math:`\rho=\eta^i-\eta^f` wrapped to (−π, π]. Ends at λ1 (mod 2π) for q = 1.
+
+    Parameters
+    ----------
+    az0, el0, bank0 : float or array_like
+        Azimuth, elevation and bank (rad) at the start of the step.
+    az1, el1, bank1 : float or array_like
+        Azimuth, elevation and bank (rad) at the end of the step.
+    q : float or array_like
+        Fraction of the step, in [0, 1].
+
+    Returns
+    -------
+    ndarray
+        Bank λ̃(q) (rad), wrapped to (−π, π].
     """
     a = arc(az0, el0, az1, el1)
     rho = wrap_angle((a.initial - bank0) - (a.final - bank1))
@@ -124,6 +198,18 @@ def posture_change(el0, bank0, el1, bank1) -> np.ndarray:
     r"""Size :math:`\bar\omega` of a change of posture, Eq. 9: :math:`\cos\bar\omega=[\lambda_0\bullet\phi_0]\cdot[\lambda_1\bullet\phi_1]`.
 
     Equal to the angle between the two static acceleration vectors. Computed with atan2.
+
+    Parameters
+    ----------
+    el0, bank0 : float or array_like
+        Elevation φ0 and bank λ0 (rad) of the initial posture.
+    el1, bank1 : float or array_like
+        Elevation φ1 and bank λ1 (rad) of the final posture.
+
+    Returns
+    -------
+    ndarray
+        Size ω̄ (rad) of the change of posture, in [0, π].
     """
     u, v = acc_from_angles(el0, bank0), acc_from_angles(el1, bank1)
     return np.arctan2(np.linalg.norm(np.cross(u, v), axis=-1), np.sum(u * v, axis=-1))

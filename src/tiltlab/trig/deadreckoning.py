@@ -34,6 +34,22 @@ def lonlat_to_local(
     r"""§8 local flat-Earth step between two fixes (radians): :math:`X=R(\Xi_1-\Xi_0)\cos((\Psi_0+\Psi_1)/2)`, :math:`Y=R(\Psi_1-\Psi_0)` (m).
 
     The longitude difference is wrapped to (−π, π].
+
+    Parameters
+    ----------
+    lon0, lat0 : float or array_like
+        Longitude Ξ0 and latitude Ψ0 (rad) of the first fix.
+    lon1, lat1 : float or array_like
+        Longitude Ξ1 and latitude Ψ1 (rad) of the second fix.
+    radius : float
+        Earth radius R (m), > 0; default :data:`EARTH_RADIUS`.
+
+    Returns
+    -------
+    x : ndarray
+        Eastward displacement X (m).
+    y : ndarray
+        Northward displacement Y (m).
     """
     radius = _v.positive(radius, "radius")
     lat0, lat1 = np.asarray(lat0, float), np.asarray(lat1, float)
@@ -48,6 +64,24 @@ def local_to_lonlat(
 
     A step centred on a pole (cos of the mean latitude 0) has no longitude: NaN, with a
     :class:`RuntimeWarning`.
+
+    Parameters
+    ----------
+    x, y : float or array_like
+        Eastward and northward displacement (m) from the first fix.
+    lon0, lat0 : float or array_like
+        Longitude Ξ0 and latitude Ψ0 (rad) of the first fix.
+    lat1 : float or array_like
+        Latitude Ψ1 (rad) of the second fix (sets the mean latitude of the step).
+    radius : float
+        Earth radius R (m), > 0; default :data:`EARTH_RADIUS`.
+
+    Returns
+    -------
+    lon : ndarray
+        Longitude ξ (rad), wrapped to (−π, π]; NaN for a step centred on a pole.
+    lat : ndarray
+        Latitude ψ (rad).
     """
     radius = _v.positive(radius, "radius")
     c = np.cos((np.asarray(lat0, float) + np.asarray(lat1, float)) / 2)
@@ -67,7 +101,22 @@ def local_to_lonlat(
 
 
 def velocity_components(speed, az, el=None) -> np.ndarray:
-    r"""Velocity (proxy) vectors :math:`\tilde v_i[\theta_i\bullet\phi_i]`, shape (N, 3) (elevation 0 if ``el`` is None)."""
+    r"""Velocity (proxy) vectors :math:`\tilde v_i[\theta_i\bullet\phi_i]`, shape (N, 3) (elevation 0 if ``el`` is None).
+
+    Parameters
+    ----------
+    speed : array_like, shape (N,)
+        Speed proxy ṽ_i (any positive scale, e.g. m/s).
+    az : array_like, shape (N,)
+        Azimuth θ_i (rad, ccw from East).
+    el : array_like, shape (N,), optional
+        Elevation φ_i (rad); None for a horizontal path.
+
+    Returns
+    -------
+    ndarray, shape (N, 3)
+        (East, North, Up) velocity components, in the units of ``speed``.
+    """
     el = np.zeros_like(np.asarray(az, float)) if el is None else el
     return np.asarray(speed, float)[..., None] * unit_vector(az, el)
 
@@ -210,6 +259,22 @@ def dead_reckon_2d(speed, az, anchors, anchor_steps) -> np.ndarray:
 
     Equal to :func:`dead_reckon` with zero elevations. ``anchors`` shape (M, 2);
     returns (N+1, 2). Same fallback for a null proxy sum.
+
+    Parameters
+    ----------
+    speed : array_like, shape (N,)
+        Speed proxy ṽ_i of each step (any positive scale).
+    az : array_like, shape (N,)
+        Azimuth θ_i (rad, ccw from East) of each step.
+    anchors : array_like, shape (M, 2)
+        Anchor positions (East, North; m) at step indices ``anchor_steps``.
+    anchor_steps : array_like of int, shape (M,)
+        Strictly increasing, from 0 to N.
+
+    Returns
+    -------
+    ndarray, shape (N+1, 2)
+        Positions (m); row ``anchor_steps[I]`` equals ``anchors[I]`` up to rounding.
     """
     v = velocity_components(*_steps(speed=speed, az=az))[:, :2]
     n = v.shape[0]
@@ -244,6 +309,22 @@ def anchored_errors(truth, speed, az, el, intervals) -> tuple[np.ndarray, np.nda
     ``truth`` (N+1, 3) gives both the anchors (every ``interval`` steps, plus the
     last position) and the reference; ``speed``, ``az``, ``el`` are the (noisy)
     per-step inputs. Returns two arrays (mean, max) with one value per interval (m).
+
+    Parameters
+    ----------
+    truth : array_like, shape (N+1, 3)
+        True positions (m, local ENU).
+    speed, az, el : array_like, shape (N,)
+        Speed proxy and azimuth and elevation (rad) of each step.
+    intervals : iterable of int
+        Anchor spacings (number of steps, ≥ 1) to evaluate.
+
+    Returns
+    -------
+    mean : ndarray, shape (len(intervals),)
+        Mean position error (m) for each interval.
+    max : ndarray, shape (len(intervals),)
+        Maximum position error (m) for each interval.
     """
     truth = _vec3(truth, "truth")
     n = truth.shape[0] - 1

@@ -108,6 +108,23 @@ def mounting_azimuth_offset(
     and ``observed_bearing`` the visually assessed body bearing θ^obs (clockwise from
     North, radians, as read on a compass). Pass the result as ``dtheta`` to
     :func:`~tiltlab.frames.mounting_matrix` / :func:`~tiltlab.frames.device_to_body`.
+
+    Parameters
+    ----------
+    acc_rest : xarray.Dataset, xarray.DataArray or array_like (..., 3)
+        Device-frame static acceleration at rest (a Recording: its ``acc`` and ``mag``).
+    mag_rest : xarray.DataArray or array_like (..., 3), optional
+        Device-frame magnetic field at rest (any unit); None to read it from a
+        Recording.
+    observed_bearing : float or array_like
+        Observed body bearing θ^obs (rad, clockwise from North).
+    convention : {"tiltlab", "benhamou"}
+        Sign of ``acc_rest``: specific force (tiltlab) or gravity (Benhamou).
+
+    Returns
+    -------
+    ndarray
+        Azimuth mismatch Δθ (rad), wrapped to (−π, π].
     """
     theta_star = azimuth(acc_rest, mag_rest, convention=convention)
     bearing = _v.vectors(observed_bearing, "observed_bearing", width=None, ndim=None)
@@ -171,6 +188,23 @@ def collar_azimuth(
     Same expression as Eq. 5 applied to :math:`\bar{\mathbf a}, \bar{\mathbf m}`
     (device frame): valid for the body when the animal moves unbanked and the device
     surge axis is orthogonal to the collar plane, whatever the collar roll.
+
+    Parameters
+    ----------
+    acc : xarray.Dataset, xarray.DataArray or array_like (..., 3)
+        Device-frame static acceleration (a Recording: its ``acc``, and its ``mag`` if
+        ``mag`` is None).
+    mag : xarray.DataArray or array_like (..., 3), optional
+        Device-frame mean magnetic field (any unit).
+    convention : {"tiltlab", "benhamou"}
+        Sign of ``acc``: specific force (tiltlab) or gravity (Benhamou).
+    declination : float or array_like
+        Magnetic declination (rad, positive East) subtracted; 0 gives magnetic azimuth.
+
+    Returns
+    -------
+    ndarray or xarray.DataArray
+        Azimuth (rad, ccw from East), wrapped to (−π, π]; NaN where undefined.
     """
     return azimuth(acc, mag, convention=convention, declination=declination)
 
@@ -190,6 +224,25 @@ def heading(
     ``mag``). Returns an :class:`~tiltlab.frames.Orientation` in radians (DataArrays
     for labelled input). Undefined angles are NaN with a :class:`RuntimeWarning`: the
     azimuth as in :func:`azimuth`, and all three where the acceleration is zero.
+
+    Parameters
+    ----------
+    acc : xarray.Dataset, xarray.DataArray or array_like (..., 3)
+        Body-frame static acceleration (a Recording: its ``acc``, and its ``mag`` if
+        ``mag`` is None).
+    mag : xarray.DataArray or array_like (..., 3), optional
+        Calibrated body-frame magnetic field (any unit).
+    convention : {"tiltlab", "benhamou"}
+        Sign of ``acc``: specific force (tiltlab) or gravity (Benhamou).
+    declination : float or array_like
+        Magnetic declination (rad, positive East) subtracted from the azimuth.
+    singular_tol : float
+        Relative tolerance (> 0) for the singular (φ ≈ ±π/2) and undefined cases.
+
+    Returns
+    -------
+    Orientation
+        Azimuth θ, elevation φ and bank λ (rad).
     """
     singular_tol = _v.positive(singular_tol, "singular_tol")
     decl = _declination(declination)
@@ -218,6 +271,22 @@ def body_azimuth_from_device(device_azimuth, elevation, bank, phi_star) -> np.nd
 
     θ^d is the device azimuth (Eq. 18 on device vectors), φ, λ the body posture and
     φ* the longitudinal mounting tilt (device surge axis in the sagittal plane).
+
+    Parameters
+    ----------
+    device_azimuth : float or array_like
+        Device azimuth θ^d (rad).
+    elevation : float or array_like
+        Body elevation φ (rad).
+    bank : float or array_like
+        Body bank λ (rad).
+    phi_star : float or array_like
+        Longitudinal mounting tilt φ* (rad).
+
+    Returns
+    -------
+    ndarray
+        Body azimuth θ (rad), wrapped to (−π, π].
     """
     c = np.einsum(
         "...ij,...j->...i", R2(elevation) @ R1(bank), unit_vector(0.0, phi_star)
@@ -230,5 +299,18 @@ def body_azimuth_from_device(device_azimuth, elevation, bank, phi_star) -> np.nd
 @angle_function("azimuth")
 def apply_declination(magnetic_azimuth, declination) -> np.ndarray:
     """True azimuth = magnetic azimuth − declination (rad, declination positive East),
-    wrapped to (−π, π]."""
+    wrapped to (−π, π].
+
+    Parameters
+    ----------
+    magnetic_azimuth : float or array_like
+        Magnetic azimuth (rad).
+    declination : float or array_like
+        Magnetic declination (rad, positive East).
+
+    Returns
+    -------
+    ndarray
+        True azimuth (rad).
+    """
     return wrap_angle(np.asarray(magnetic_azimuth, float) - _declination(declination))

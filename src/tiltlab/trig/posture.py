@@ -92,6 +92,20 @@ def inclination_from_angles(elevation, bank) -> tuple[np.ndarray, np.ndarray]:
     \cos\phi\cos\lambda)`.
 
     In particular :math:`\cos\zeta=\cos\phi\cos\lambda`.
+
+    Parameters
+    ----------
+    elevation : float or array_like
+        Elevation φ (rad).
+    bank : float or array_like
+        Bank λ (rad).
+
+    Returns
+    -------
+    inclination : ndarray
+        Overall inclination ζ (rad), in [0, π].
+    orientation : ndarray
+        Postural orientation χ (rad), in (−π, π].
     """
     v = acc_from_angles(elevation, bank)
     zeta = np.arctan2(np.hypot(v[..., 0], v[..., 1]), v[..., 2])
@@ -101,7 +115,22 @@ def inclination_from_angles(elevation, bank) -> tuple[np.ndarray, np.ndarray]:
 @angle_function(("elevation", "bank"))
 def angles_from_inclination(inclination, orientation) -> tuple[np.ndarray, np.ndarray]:
     r"""(φ, λ) from (ζ, χ): :math:`\phi=\sin^{-1}(\sin\zeta\cos\chi)`,
-    :math:`\lambda=\mathrm{atan2}(\sin\zeta\sin\chi,\cos\zeta)`."""
+    :math:`\lambda=\mathrm{atan2}(\sin\zeta\sin\chi,\cos\zeta)`.
+
+    Parameters
+    ----------
+    inclination : float or array_like
+        Overall inclination ζ (rad).
+    orientation : float or array_like
+        Postural orientation χ (rad).
+
+    Returns
+    -------
+    elevation : ndarray
+        Elevation φ (rad), in [−π/2, π/2].
+    bank : ndarray
+        Bank λ (rad), in (−π, π].
+    """
     z, c = np.broadcast_arrays(
         np.asarray(inclination, float), np.asarray(orientation, float)
     )
@@ -115,6 +144,20 @@ def correct_tangential(elevation, tangential_acc, *, g: float = 9.81) -> np.ndar
     :math:`\phi - \tan^{-1}(h/g)`.
 
     ``tangential_acc`` and ``g`` in the same units; h < 0 for a deceleration.
+
+    Parameters
+    ----------
+    elevation : float or array_like
+        Elevation φ (rad) from the acceleration.
+    tangential_acc : float or array_like
+        Forward acceleration h = Δv/Δt (e.g. m/s²), negative for a deceleration.
+    g : float
+        Gravity in the units of ``tangential_acc`` (default 9.81, m/s²), > 0.
+
+    Returns
+    -------
+    ndarray
+        Corrected elevation (rad).
     """
     g = _v.positive(g, "g")
     return np.asarray(elevation, float) - np.arctan2(
@@ -130,6 +173,22 @@ def correct_centripetal(bank, speed, curvature, *, g: float = 9.81) -> np.ndarra
     ``curvature`` κ = 1/r is signed, positive for a left (counter-clockwise) turn,
     which reproduces Benhamou's "− for a left turn, + for a right turn". κ = 0 is a
     straight path (no NaN). ``speed`` and ``g`` in consistent units (m/s, m/s²).
+
+    Parameters
+    ----------
+    bank : float or array_like
+        Bank λ (rad) from the acceleration.
+    speed : float or array_like
+        Horizontal speed v (e.g. m/s).
+    curvature : float or array_like
+        Signed path curvature κ = 1/r (e.g. 1/m), positive for a left turn.
+    g : float
+        Gravity in units consistent with v²κ (default 9.81, m/s²), > 0.
+
+    Returns
+    -------
+    ndarray
+        Corrected bank (rad).
     """
     g = _v.positive(g, "g")
     v = np.asarray(speed, float)
@@ -144,6 +203,18 @@ def magnetic_posture(mag) -> tuple[np.ndarray, np.ndarray]:
     to the (dipping) field, hence hard to interpret on its own. ``mag``: a Recording
     (its ``mag``), a labelled DataArray or an array (..., 3). Zero field vectors give
     NaN with a :class:`RuntimeWarning`.
+
+    Parameters
+    ----------
+    mag : xarray.Dataset, xarray.DataArray or array_like (..., 3)
+        Body-frame magnetic field (any unit; a Recording: its ``mag``).
+
+    Returns
+    -------
+    magnetic_elevation : ndarray or xarray.DataArray
+        Magnetic 'elevation' (rad).
+    magnetic_bank : ndarray or xarray.DataArray
+        Magnetic 'bank' (rad).
     """
     s = read(mag, "mag")
     el, bk = _elev_bank(s.values)
@@ -166,6 +237,27 @@ def posture_from_magnetic_loop(
     :math:`\lambda=\tan^{-1}(-\mathrm{sgn}(I)\Sigma M_V/|\Sigma M_W|)`.
     Returns (ζ, φ, λ); valid for |λ| < π/2. A zero sum (e.g. a field that cancels
     over the loop) has no direction: an error naming ``mag_loop``.
+
+    Parameters
+    ----------
+    mag_loop : xarray.Dataset, xarray.DataArray or array_like (N, 3)
+        Body-frame magnetic vectors sampled evenly over one loop (any unit; no NaN).
+    inclination : float
+        Geomagnetic dip I (rad), positive downward.
+
+    Returns
+    -------
+    zeta : float
+        Overall inclination ζ (rad).
+    phi : float
+        Elevation φ (rad).
+    lam : float
+        Bank λ (rad).
+
+    Raises
+    ------
+    ValueError
+        If the field vectors sum to zero.
     """
     inclination = _v.finite(inclination, "inclination")
     m = read(mag_loop, "mag_loop", var="mag", allow_nan=False).values

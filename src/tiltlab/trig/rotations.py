@@ -99,6 +99,20 @@ def sequential_yaw_pitch(size, eta) -> tuple[np.ndarray, np.ndarray]:
     atan2(cos η sin ω, cos ω)) and :math:`\beta=\sin^{-1}(\sin\eta\sin\omega)`, i.e.
     :math:`[\alpha\bullet\beta]^\top=R_1(\eta)[\omega\bullet0]^\top`. Accurate for the
     simultaneous rotations only for small ω (see :func:`simultaneous_rotations`).
+
+    Parameters
+    ----------
+    size : float or array_like
+        Arc size ω (rad).
+    eta : float or array_like
+        Body-relative inclination η of the arc (rad); broadcasts with ``size``.
+
+    Returns
+    -------
+    yaw : ndarray
+        Yaw α (rad), rotation about the heave axis applied first.
+    pitch : ndarray
+        Pitch β (rad), rotation about the sway axis applied second.
     """
     w, e = np.broadcast_arrays(np.asarray(size, float), np.asarray(eta, float))
     return np.arctan2(np.cos(e) * np.sin(w), np.cos(w)), np.arcsin(
@@ -113,6 +127,20 @@ def sequential_arc_from_yaw_pitch(yaw, pitch) -> tuple[np.ndarray, np.ndarray]:
     From :math:`[\alpha\bullet\beta]=(\cos\omega, \sin\omega\cos\eta, \sin\omega\sin\eta)`:
     :math:`\omega=\mathrm{atan2}\big((\sin^2\alpha\cos^2\beta+\sin^2\beta)^{1/2}, \cos\alpha\cos\beta\big)`,
     :math:`\eta=\mathrm{atan2}(\sin\beta, \sin\alpha\cos\beta)` (0 when ω = 0). Returns (ω, η).
+
+    Parameters
+    ----------
+    yaw : float or array_like
+        Yaw α (rad), applied first.
+    pitch : float or array_like
+        Pitch β (rad), applied second; broadcasts with ``yaw``.
+
+    Returns
+    -------
+    size : ndarray
+        Arc size ω (rad), in [0, π].
+    eta : ndarray
+        Body-relative inclination η (rad), in (−π, π].
     """
     v = unit_vector(yaw, pitch)
     return np.arctan2(np.hypot(v[..., 1], v[..., 2]), v[..., 0]), np.arctan2(
@@ -125,6 +153,20 @@ def heading_in_body_frame(az0, el0, bank0, az1, el1) -> tuple[np.ndarray, np.nda
     r"""§6: heading at step i in the body frame of step i−1: :math:`[\alpha\bullet\beta]^\top=R_1(-\lambda_0)R_2(-\phi_0)R_3(-\theta_0)[\theta_1\bullet\phi_1]^\top`.
 
     Returns (α, β) of the sequential decomposition; equals Eq. 10 with η = δ^i − λ0.
+
+    Parameters
+    ----------
+    az0, el0, bank0 : float or array_like
+        Azimuth θ0, elevation φ0 and bank λ0 (rad) of the orientation at step i−1.
+    az1, el1 : float or array_like
+        Azimuth θ1 and elevation φ1 (rad) of the heading at step i.
+
+    Returns
+    -------
+    yaw : ndarray
+        Azimuth α (rad) of the new heading in the previous body frame.
+    pitch : ndarray
+        Elevation β (rad) of the new heading in the previous body frame.
     """
     C0 = angles_to_matrix(az0, el0, bank0)
     v = np.einsum("...ji,...j->...i", C0, unit_vector(az1, el1))
@@ -145,6 +187,20 @@ def simultaneous_rotations(size, eta_initial, eta_final) -> Rotations:
     sinc so ρ = 0 (no roll: α = ω cos η, β = ω sin η) is handled without NaN.
     These are the exact integrals of the gyroscope for the constant-rate model of
     :func:`exact_step`.
+
+    Parameters
+    ----------
+    size : float or array_like
+        Arc size ω (rad).
+    eta_initial : float or array_like
+        Initial body-relative inclination η^i = δ^i − λ0 (rad).
+    eta_final : float or array_like
+        Final body-relative inclination η^f = δ^f − λ1 (rad).
+
+    Returns
+    -------
+    Rotations
+        Yaw α, pitch β and roll ρ (rad) integrated over the step.
     """
     w, ei, ef = np.broadcast_arrays(
         *(np.asarray(a, float) for a in (size, eta_initial, eta_final))
@@ -166,7 +222,27 @@ def rotations_from_orientations(
     *,
     method: Literal["simultaneous", "sequential"] = "simultaneous",
 ) -> Rotations:
-    """Yaw, pitch, roll between two orientations: Eq. 11 (``"simultaneous"``) or Eq. 10 (``"sequential"``, roll = η^i − η^f)."""
+    """Yaw, pitch, roll between two orientations: Eq. 11 (``"simultaneous"``) or Eq. 10 (``"sequential"``, roll = η^i − η^f).
+
+    Parameters
+    ----------
+    az0, el0, bank0 : float or array_like
+        Azimuth, elevation and bank (rad) at the start of the step.
+    az1, el1, bank1 : float or array_like
+        Azimuth, elevation and bank (rad) at the end of the step.
+    method : {"simultaneous", "sequential"}
+        Eq. 11 simultaneous rotations (default) or Eq. 10 yaw-then-pitch decomposition.
+
+    Returns
+    -------
+    Rotations
+        Yaw α, pitch β and roll ρ (rad); roll wrapped to (−π, π].
+
+    Raises
+    ------
+    ValueError
+        If ``method`` is not one of the two choices.
+    """
     a = arc(az0, el0, az1, el1)
     ei = a.initial - np.asarray(bank0, float)
     ef = a.final - np.asarray(bank1, float)
@@ -185,6 +261,22 @@ def arc_from_rotations(yaw, pitch, roll) -> tuple[np.ndarray, np.ndarray]:
     :math:`\omega=\tfrac12\rho(\alpha^2+\beta^2)^{1/2}/\sin(\rho/2)` (sinc form, finite at
     ρ = 0) and :math:`\bar\eta=\mathrm{atan2}(\beta,\alpha)` (0 when ω = 0, where it
     is undefined). Valid for |ρ| ≤ π. Returns (ω, η̄).
+
+    Parameters
+    ----------
+    yaw : float or array_like
+        Yaw α (rad) summed over the step (rotation about the heave axis).
+    pitch : float or array_like
+        Pitch β (rad) summed over the step (rotation about the sway axis).
+    roll : float or array_like
+        Roll ρ (rad) summed over the step (rotation about the surge axis).
+
+    Returns
+    -------
+    size : ndarray
+        Arc size ω (rad).
+    eta : ndarray
+        Mean body-relative inclination η̄ (rad).
     """
     al, be, ro = np.broadcast_arrays(
         *(np.asarray(a, float) for a in (yaw, pitch, roll))
@@ -201,6 +293,20 @@ def azimuth_change(el0, bank0, el1, bank1, yaw, pitch, roll) -> np.ndarray:
 
     with :math:`\delta^i=\lambda_0+\bar\eta+\rho/2`, :math:`\delta^f=\lambda_1+\bar\eta-\rho/2` and ω, η̄
     from Eq. 12.
+
+    Parameters
+    ----------
+    el0, bank0 : float or array_like
+        Elevation φ0 and bank λ0 (rad) at the start of the step.
+    el1, bank1 : float or array_like
+        Elevation φ1 and bank λ1 (rad) at the end of the step.
+    yaw, pitch, roll : float or array_like
+        Gyroscope rotations α, β, ρ (rad) over the step (:func:`body_rotations`).
+
+    Returns
+    -------
+    ndarray
+        Change of azimuth Δθ (rad) over the step, in (−π, π].
     """
     w, eb = arc_from_rotations(yaw, pitch, roll)
     ro = np.asarray(roll, float)
@@ -221,6 +327,24 @@ def sub_arc_rotations(
     :math:`\alpha_{i,j}=\tan^{-1}(\cos\tilde\eta(q)\tan(\omega/k))`,
     :math:`\beta_{i,j}=\sin^{-1}(\sin\tilde\eta(q)\sin(\omega/k))`, :math:`\tilde\eta(q)=\eta^i-q\rho`, q = j/k
     (as printed). Each block also rolls by ρ/k. Their sums converge to Eq. 11 as k → ∞.
+
+    Parameters
+    ----------
+    size : float
+        Arc size ω (rad).
+    eta_initial : float
+        Initial body-relative inclination η^i (rad).
+    roll : float
+        Total roll ρ (rad) over the step.
+    k : int
+        Number of sub-arcs (blocks), ≥ 1.
+
+    Returns
+    -------
+    yaw : ndarray, shape (k,)
+        Per-block yaw α_{i,j} (rad).
+    pitch : ndarray, shape (k,)
+        Per-block pitch β_{i,j} (rad).
     """
     k = _v.integer(k, "k", minimum=1)
     q = np.arange(1, k + 1) / k
@@ -244,6 +368,24 @@ def compose_sub_arcs(
 
     Rotations are intrinsic (body axes): :math:`C \leftarrow C\,R_1(\rho/k)\,R_3(\alpha_{i,j})\,R_2(\beta_{i,j})`
     (Benhamou's :math:`R_2` makes a positive pitch raise the nose).
+
+    Parameters
+    ----------
+    az0, el0, bank0 : float
+        Azimuth, elevation and bank (rad) at the start of the step.
+    size : float
+        Arc size ω (rad).
+    eta_initial : float
+        Initial body-relative inclination η^i (rad).
+    roll : float
+        Total roll ρ (rad) over the step.
+    k : int
+        Number of sub-arcs (blocks), ≥ 1.
+
+    Returns
+    -------
+    ndarray, shape (3, 3)
+        Body→world rotation matrix at the end of the step.
     """
     k = _v.integer(k, "k", minimum=1)
     al, be = sub_arc_rotations(size, eta_initial, roll, k)
@@ -275,6 +417,22 @@ def exact_step(az0, el0, bank0, initial_inclination, size, roll) -> np.ndarray:
     (θ0, φ0) with inclination δ^i over an arc ω, while the body rolls at constant
     speed by ρ about the surge axis: :math:`C_1 = \mathrm{Rot}(\mathbf n,\omega)\,C_0\,R_1(\rho)`
     with n the unit normal of the reorientation plane. Returns (..., 3, 3).
+
+    Parameters
+    ----------
+    az0, el0, bank0 : float or array_like
+        Azimuth θ0, elevation φ0 and bank λ0 (rad) at the start of the step.
+    initial_inclination : float or array_like
+        Initial inclination δ^i (rad) of the arc in the frontal plane.
+    size : float or array_like
+        Arc size ω (rad).
+    roll : float or array_like
+        Roll ρ (rad) about the surge axis over the step.
+
+    Returns
+    -------
+    ndarray, shape (..., 3, 3)
+        Body→world rotation matrix C1 at the end of the step.
     """
     C0 = angles_to_matrix(az0, el0, bank0)
     d = np.asarray(initial_inclination, float)
@@ -296,6 +454,24 @@ def step_body_rates(
     :math:`\omega_z=\dot\alpha=\cos\tilde\eta(t)\,\omega/\Delta t`, :math:`\tilde\eta(t)=\eta^i-\rho t/\Delta t`.
     Feeding it to :func:`tiltlab.quaternion.integrate_gyro` reproduces the step (to the
     zero-order-hold error of the integrator).
+
+    Parameters
+    ----------
+    size : float
+        Arc size ω (rad).
+    eta_initial : float
+        Initial body-relative inclination η^i (rad).
+    roll : float
+        Total roll ρ (rad) over the step.
+    duration_s : float
+        Step duration Δt (s), > 0.
+    n : int
+        Number of samples (midpoints), ≥ 1.
+
+    Returns
+    -------
+    ndarray, shape (n, 3)
+        Body-frame angular velocity (ω_x, ω_y, ω_z) in rad/s.
     """
     n = _v.integer(n, "n", minimum=1)
     duration_s = _v.positive(duration_s, "duration_s")
@@ -318,6 +494,21 @@ def head_relative_to_body(
     :math:`\theta_{h/b}=\mathrm{atan2}(y,x)`, :math:`\phi_{h/b}=\sin^{-1}z`,
     :math:`\lambda_{h/b}=\mathrm{atan2}(z', z'')` with :math:`z''=xy'-yx'`. Singular
     case (head surge orthogonal to the body coronal plane): θ = θ' − π/2, φ = sgn(z)π/2, λ = 0.
+
+    Parameters
+    ----------
+    az_b, el_b, bank_b : float or array_like
+        Azimuth, elevation and bank (rad) of the body.
+    az_h, el_h, bank_h : float or array_like
+        Azimuth, elevation and bank (rad) of the head.
+    singular_tol : float
+        Threshold (> 0) on the horizontal norm of the head surge axis in the body frame
+        below which the singular fallback is used.
+
+    Returns
+    -------
+    Orientation
+        Azimuth, elevation and bank (rad) of the head in the body frame.
     """
     singular_tol = _v.positive(singular_tol, "singular_tol")
     Cb = angles_to_matrix(az_b, el_b, bank_b)
@@ -358,6 +549,31 @@ def cap_passage(
     (:math:`a=\cos\omega_{I\mu}`, b = tangent·μ). The last term of b is evaluated as
     :math:`\sin\psi_\mu\cos\psi_I-\sin\psi_I\cos\psi_\mu\cos(\xi_\mu-\xi_I)` (algebraically
     identical, finite at the poles). P from Eq. 6 with δ^i_IO and ω_IP.
+
+    Parameters
+    ----------
+    xi_in, psi_in : float or array_like
+        Longitude ξ_I and latitude ψ_I (rad) of the inside location I.
+    xi_out, psi_out : float or array_like
+        Longitude ξ_O and latitude ψ_O (rad) of the outside location O.
+    xi_mu, psi_mu : float or array_like
+        Longitude ξ_μ and latitude ψ_μ (rad) of the cap centre μ.
+    radius : float or array_like
+        Angular radius ω_Pμ of the cap (rad), in (0, π/2).
+
+    Returns
+    -------
+    arc_to_passage : ndarray
+        Arc ω_IP (rad) from I to the passage point P.
+    fraction : ndarray
+        ω_IP/ω_IO, the fraction of the arc I → O at which P lies (0 if I = O).
+    longitude, latitude : ndarray
+        Longitude ξ_P and latitude ψ_P (rad) of P.
+
+    Raises
+    ------
+    ValueError
+        If ``radius`` is not in (0, π/2).
     """
     r = np.asarray(radius, float)
     bad = ~np.isfinite(r) | (r <= 0) | (r >= np.pi / 2)
