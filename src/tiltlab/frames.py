@@ -41,6 +41,15 @@ import numpy as np
 
 from . import _validate as _v
 from . import quaternion as _quat
+from ._frames_lab import (
+    _angle,
+    _nonzero,
+    _vec3,
+    fibonacci_lattice,
+    head_frame_from_markers,
+    stage_angles,
+    stage_quaternion,
+)
 
 __all__ = [
     "Convention",
@@ -73,7 +82,6 @@ __all__ = [
 ]
 
 Convention = Literal["tiltlab", "benhamou"]
-_GOLDEN = (1.0 + 5.0**0.5) / 2.0
 
 
 class Orientation(NamedTuple):
@@ -82,23 +90,6 @@ class Orientation(NamedTuple):
     azimuth: np.ndarray
     elevation: np.ndarray
     bank: np.ndarray
-
-
-def _vec3(a, name: str) -> np.ndarray:
-    a = np.asarray(a, dtype=float)
-    if a.ndim == 0 or a.shape[-1] != 3:
-        raise ValueError(
-            f"{name} must have a last dimension of size 3, got shape {a.shape}"
-        )
-    return a
-
-
-def _angle(a, name: str) -> np.ndarray:
-    """Angles (rad) as floats; NaN (undefined) passes, an infinite angle raises."""
-    a = np.asarray(a, dtype=float)
-    if np.any(np.isinf(a)):
-        raise ValueError(f"{name} has {int(np.sum(np.isinf(a)))} infinite values")
-    return a
 
 
 def _convention(convention) -> str:
@@ -114,17 +105,6 @@ def _as_benhamou(acc, convention: Convention, name: str = "acc") -> np.ndarray:
     if _convention(convention) == "tiltlab":
         return -acc
     return acc.copy()
-
-
-def _nonzero(a: np.ndarray, name: str, what: str = "vector") -> np.ndarray:
-    """``a`` (…, 3) unchanged; a zero (finite) vector, which has no direction, raises."""
-    n = np.linalg.norm(a, axis=-1)
-    if np.any(n == 0):
-        k = int(np.sum(n == 0))
-        raise ValueError(
-            f"{name} has {k} zero {what}{'s' if k > 1 else ''}: its direction is undefined"
-        )
-    return a
 
 
 def _clip1(x):
@@ -701,127 +681,3 @@ def device_to_body_eq1(
     BV = (DW * aV - DV * aW) / s
     BW = -(DU * aU + DV * aV + DW * aW) / n
     return np.stack(np.broadcast_arrays(BU, BV, BW), axis=-1)
-
-
-# ---------------------------------------------------------------------------
-# tumble stage and the Fibonacci lattice (Fayat App. A.1)
-# ---------------------------------------------------------------------------
-
-
-def fibonacci_lattice(n: int = 5000) -> np.ndarray:
-    r"""Spherical Fibonacci lattice of ``n`` nearly uniform unit vectors, shape (n, 3).
-
-    Point :math:`i = 0,\dots,n-1` has :math:`z_i = 1 - (2i+1)/n` (equal-area latitude
-    bands) and longitude :math:`2\pi i/\Phi` with the golden ratio :math:`\Phi` [3]_.
-
-    Parameters
-    ----------
-    n : int, optional
-        Number of points (≥ 1); default 5000.
-
-    Returns
-    -------
-    numpy.ndarray, shape (n, 3)
-        Unit vectors (dimensionless), from near the north pole (z ≈ 1) southwards.
-    """
-    if isinstance(n, bool) or int(n) != n or n < 1:
-        raise ValueError(f"n must be a positive integer, got {n!r}")
-    i = np.arange(int(n), dtype=float)
-    z = 1.0 - (2.0 * i + 1.0) / n
-    r = np.sqrt(np.clip(1.0 - z * z, 0.0, None))
-    lon = 2.0 * np.pi * ((i / _GOLDEN) % 1.0)
-    return np.column_stack([r * np.cos(lon), r * np.sin(lon), z])
-
-
-def stage_angles(g) -> tuple[np.ndarray, np.ndarray]:
-    r"""Stage pitch β and roll γ (rad) bringing gravity-up to ``g`` in the sensor frame.
-
-    With the stage :math:`R = R_y(\beta) R_x(\gamma)`, the tilt is
-    :math:`g = R^\top e_z = (-\sin\beta, \sin\gamma\cos\beta, \cos\gamma\cos\beta)`,
-    so :math:`\beta = -\arcsin g_x` and :math:`\gamma = \operatorname{atan2}(g_y, g_z)`.
-
-    Parameters
-    ----------
-    g : array_like, shape (..., 3)
-        Target gravity-up directions in the sensor frame; non-zero, need not be unit
-        (any unit).
-
-    Returns
-    -------
-    pitch : numpy.ndarray, shape (...)
-        Stage pitch β in rad, in [−π/2, π/2].
-    roll : numpy.ndarray, shape (...)
-        Stage roll γ in rad, in (−π, π].
-    """
-    g = _nonzero(_vec3(g, "g"), "g")
-    g = g / np.linalg.norm(g, axis=-1, keepdims=True)
-    # atan2 form of beta = -asin(g_x): accurate near the poles too
-    return np.arctan2(-g[..., 0], np.hypot(g[..., 1], g[..., 2])), np.arctan2(
-        g[..., 1], g[..., 2]
-    )
-
-
-def stage_quaternion(pitch, roll) -> np.ndarray:
-    """Orientation ``R_y(pitch) R_x(roll)`` (sensor → world) of the two-axis stage.
-
-    Parameters
-    ----------
-    pitch : array_like
-        Stage pitch β in rad (rotation about y).
-    roll : array_like
-        Stage roll γ in rad (rotation about x). ``pitch`` and ``roll`` broadcast.
-
-    Returns
-    -------
-    numpy.ndarray, shape (..., 4)
-        Unit sensor → world quaternions (w, x, y, z).
-    """
-    pitch, roll = np.broadcast_arrays(_angle(pitch, "pitch"), _angle(roll, "roll"))
-    z = np.zeros_like(pitch)
-    return _quat.mul(
-        _quat.from_rotvec(np.stack([z, pitch, z], -1)),
-        _quat.from_rotvec(np.stack([roll, z, z], -1)),
-    )
-
-
-# ---------------------------------------------------------------------------
-# marker head frame (Fayat §2.6.4)
-# ---------------------------------------------------------------------------
-
-
-def head_frame_from_markers(m1, m2, m3) -> np.ndarray:
-    r"""Head frame of Fayat §2.6.4 from markers 1–3: rotation matrices (..., 3, 3) whose
-    columns are :math:`h_x, h_y, h_z` in mocap (world) coordinates.
-
-    :math:`h_y = (m_1 - m_2)/\|\cdot\|`, :math:`h_z = (m_3 - m_2) \times h_y / \|\cdot\|`,
-    :math:`h_x = h_y \times h_z`.
-
-    Parameters
-    ----------
-    m1, m2, m3 : array_like, shape (..., 3)
-        Positions of markers 1, 2 and 3 in mocap (world) coordinates, in any length
-        unit; not coincident or collinear. They broadcast; NaN (missing marker)
-        propagates.
-
-    Returns
-    -------
-    numpy.ndarray, shape (..., 3, 3)
-        Head → world rotation matrices with columns ``h_x``, ``h_y``, ``h_z``.
-    """
-    m1, m2, m3 = (_vec3(v, n) for v, n in ((m1, "m1"), (m2, "m2"), (m3, "m3")))
-    v21, v23 = m1 - m2, m3 - m2
-    n21 = np.linalg.norm(v21, axis=-1)
-    ncz = np.linalg.norm(np.cross(v23, v21), axis=-1)
-    # frames with a missing (NaN) marker give NaN; NaN compares False here
-    bad = (n21 == 0) | (ncz <= 1e-9 * n21 * np.linalg.norm(v23, axis=-1))
-    if np.any(bad):
-        raise ValueError(
-            f"markers m1, m2, m3 are coincident or collinear in {int(bad.sum())} "
-            "frame(s): the head frame is undefined"
-        )
-    hy = m1 - m2
-    hy = hy / np.linalg.norm(hy, axis=-1, keepdims=True)
-    hz = np.cross(m3 - m2, hy)
-    hz = hz / np.linalg.norm(hz, axis=-1, keepdims=True)
-    hx = np.cross(hy, hz)
-    return np.stack([hx, hy, hz], axis=-1)
