@@ -37,6 +37,8 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
+from .units import conversion_factor, normalise_unit
+
 __all__ = [
     "RecordingError",
     "Signal",
@@ -409,19 +411,19 @@ def signal(
     # units: attrs and argument must agree
     u = None
     if own_units is not None:
-        u = _units.normalise_unit(own_units)
-        if units is not None and _units.normalise_unit(units) != u:
+        u = normalise_unit(own_units)
+        if units is not None and normalise_unit(units) != u:
             raise RecordingError(
                 f"{name}: units = {units!r} contradicts the data's units {own_units!r}"
             )
     elif units is not None:
-        u = _units.normalise_unit(units)
+        u = normalise_unit(units)
     if u is None and (need_units or to_units is not None):
         hint = "add attrs['units'] to it" if labelled else "pass units="
         raise RecordingError(f"{name}: its units are unknown ({hint})")
     if to_units is not None:
-        values = values * _units.conversion_factor(u, to_units)
-        u = _units.normalise_unit(to_units)
+        values = values * conversion_factor(u, to_units)
+        u = normalise_unit(to_units)
     return Signal(values, f, u, time, labelled, attrs)
 
 
@@ -504,10 +506,6 @@ def windowed(values, like: Signal, name: str, *, centre_s, fs_out: float, units=
     if units is not None:
         attrs["units"] = units
     return xr.DataArray(values, dims=dims, coords=coords, name=name, attrs=attrs)
-
-
-# imported last: tiltlab.units re-exports check_fs from this module
-from . import units as _units  # noqa: E402
 
 
 # --------------------------------------------------------------------------- time gaps

@@ -19,7 +19,7 @@ import xarray as xr
 
 from .. import _validate as _v
 from .. import quaternion as quat
-from . import registry
+import tiltlab.filters.registry as registry
 from .registry import get_method
 
 __all__ = ["Inputs", "prepare", "run", "estimate", "gravity"]

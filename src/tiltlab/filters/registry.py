@@ -36,7 +36,7 @@ import numpy as np
 
 from .. import _validate as _v
 from .. import dsp
-from . import adapters
+import tiltlab.filters.adapters as adapters
 from ._common import unlabel
 from .complementary import complementary
 from .ekf import ekf

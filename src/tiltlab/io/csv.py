@@ -13,7 +13,7 @@ import xarray as xr
 
 from .. import _validate, schema
 from .. import quality as _quality
-from . import clock as _clock
+import tiltlab.io.clock as _clock
 from ._common import (
     PathLike,
     ReadError,

@@ -23,6 +23,7 @@ from .csv import read_csv
 from .mat import list_variables, mat_version
 from .describe import TEXT_SUFFIXES, _broad_like, detect
 from .ncfile import is_recording, netcdf_format, open_netcdf
+from .multi import read_multi
 from .netcdf import NotRecordingError, load_netcdf
 from .tagtools import read_tagtools, sensor_variables
 
@@ -103,17 +104,9 @@ def read(
     >>> rec = io.read("deployment.nc")  # a tag-tools archive  # doctest: +SKIP
     >>> rec = io.read("session.csv", mapping="mapping.json")  # doctest: +SKIP
     """
-    from .. import io as _io  # the package: read_multi lives there when available
-
     if mapping is not None:
         raw, base = _mapping_dict(mapping)
         if "files" in raw:
-            read_multi = getattr(_io, "read_multi", None)
-            if read_multi is None:
-                raise ReadError(
-                    'this mapping has "files" (one file per sensor), which needs '
-                    "tiltlab.io.read_multi, not available in this version"
-                )
             src = Path(source) if source is not None else None
             if src is not None and src.is_dir():
                 base = src

@@ -10,7 +10,7 @@ import numpy as np
 import xarray as xr
 
 from .. import _validate
-from . import clock as _clock
+import tiltlab.io.clock as _clock
 from ._common import PathLike, ReadError
 from .csv import build_recording, read_frame
 from .mapping import (
