@@ -494,7 +494,8 @@ def start_time(like: Signal) -> float:
 
 def windowed(values, like: Signal, name: str, *, centre_s, fs_out: float, units=None):
     """One value per window: a DataArray over window-centre times when ``like`` was
-    labelled (``centre_s`` relative to the first sample; ``fs_out`` = windows per s)."""
+    labelled (``centre_s`` relative to the first sample; ``fs_out`` = windows per s).
+    """
     if not like.labelled:
         return values
     values = np.asarray(values)

@@ -280,7 +280,7 @@ def from_benhamou_acc(acc) -> np.ndarray:
 
 
 def gyro_to_body_rates(gyr) -> np.ndarray:
-    r"""tiltlab angular velocity (ω_x, ω_y, ω_z) → Benhamou's (roll, pitch, yaw) speeds (ρ̇, β̇, α̇).
+    r"""Tiltlab angular velocity (ω_x, ω_y, ω_z) → Benhamou's (roll, pitch, yaw) speeds (ρ̇, β̇, α̇).
 
     :math:`\dot\rho=\omega_x`, :math:`\dot\beta=-\omega_y` (positive nose-up),
     :math:`\dot\alpha=\omega_z`. Units are kept (pass rad/s for radians).

@@ -323,7 +323,8 @@ def make_recording(
 
 def _given_units(x, units: str | None, name: str) -> str:
     """The unit of a variable: the argument, else a labelled DataArray's ``units``
-    attribute (which the argument must not contradict); never a default."""
+    attribute (which the argument must not contradict); never a default.
+    """
     label = x.attrs.get("units") if isinstance(x, xr.DataArray) else None
     if units is None:
         if label is None:

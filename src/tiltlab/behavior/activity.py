@@ -36,7 +36,8 @@ __all__ = [
 
 class StepSummary(NamedTuple):
     """One value per Δt step (§9): centre time (s), static acceleration (n, 3), mean
-    DBA."""
+    DBA.
+    """
 
     time: np.ndarray
     static: np.ndarray
@@ -68,7 +69,8 @@ def _read_acc(acc, fs):
 
 def _sliding_mean(a: np.ndarray, k: int) -> np.ndarray:
     """Centred window of k samples, truncated at the ends; NaN where the window holds
-    a non-finite sample (a gap), finite elsewhere."""
+    a non-finite sample (a gap), finite elsewhere.
+    """
     n = a.shape[0]
     before = k // 2
     after = k - 1 - before

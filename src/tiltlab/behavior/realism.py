@@ -1,5 +1,6 @@
 """Side-by-side activity statistics of recordings: how a simulated session compares with
-a real one (:func:`realism_table`), by the gyroscope or, without one, the accelerometer."""
+a real one (:func:`realism_table`), by the gyroscope or, without one, the accelerometer.
+"""
 
 from __future__ import annotations
 

@@ -128,7 +128,8 @@ def _condition_or_raise(J, what, max_condition):
 class OffsetFit(NamedTuple):
     """Offset-only fit: ``offset`` (3,), ``stderr`` (3,), ``cov`` (3, 3), ``residuals``
     (P,) signed norm errors at the solution, ``mean_abs_error`` (mean of |1 − ‖a − o‖|),
-    ``condition`` (Jacobian condition number) and ``n`` (poses)."""
+    ``condition`` (Jacobian condition number) and ``n`` (poses).
+    """
 
     offset: np.ndarray
     stderr: np.ndarray
@@ -287,7 +288,8 @@ class EllipsoidFit(NamedTuple):
     ``params``/``stderr`` (9,) [o (3), then the free entries of C: upper triangle row-major
     for "triangular", (xx, xy, xz, yy, yz, zz) for "symmetric"], ``offset_stderr`` (3,),
     ``matrix_stderr`` (3, 3), ``cov`` (9, 9), ``residuals`` (P,), ``mean_abs_error``,
-    ``condition``, ``structure``, ``n``."""
+    ``condition``, ``structure``, ``n``.
+    """
 
     offset: np.ndarray
     matrix: np.ndarray
@@ -496,7 +498,8 @@ def fit_ellipsoid(
 class LinearFit(NamedTuple):
     """Known-direction fit :math:`y = T g + o`: ``offset`` (3,), ``sensor_matrix`` T,
     ``matrix`` C = T⁻¹, ``offset_stderr`` (3,), ``sensor_matrix_stderr`` (3, 3),
-    ``residuals`` (P, 3), ``n``."""
+    ``residuals`` (P, 3), ``n``.
+    """
 
     offset: np.ndarray
     sensor_matrix: np.ndarray

@@ -114,7 +114,8 @@ def tilt_from_markers(p1, p2, p3) -> np.ndarray:
 
 class MarkerQC(NamedTuple):
     """``keep`` (N,) frames kept, ``distance`` (N,) d₁₂, ``median``, ``sigma_all``,
-    ``sigma_kept`` (units of the markers), ``tilt_uncertainty_deg``."""
+    ``sigma_kept`` (units of the markers), ``tilt_uncertainty_deg``.
+    """
 
     keep: np.ndarray
     distance: np.ndarray
@@ -194,7 +195,8 @@ def marker_distance_qc(p1, p2, *, drop_fraction: float = 0.02) -> MarkerQC:
 
 class Alignment(NamedTuple):
     """``matrix`` (3, 3) IMU→head rotation, ``quaternion`` (4,), ``rms_deg`` RMS angle
-    between aligned IMU gravity and head vertical, ``n`` samples used."""
+    between aligned IMU gravity and head vertical, ``n`` samples used.
+    """
 
     matrix: np.ndarray
     quaternion: np.ndarray

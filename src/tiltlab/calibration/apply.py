@@ -308,7 +308,8 @@ class TumbleResult(NamedTuple):
     """Output of :func:`tumble_calibration`: the ``calibration``, the still ``intervals``,
     per-period accelerometer statistics ``acc_stats``, the accelerometer ``fit``
     (:class:`OffsetFit` or :class:`EllipsoidFit`) and ``gyr_stderr`` (°/s; None for a
-    recording without a gyroscope)."""
+    recording without a gyroscope).
+    """
 
     calibration: Calibration
     intervals: np.ndarray

@@ -33,7 +33,8 @@ __all__ = ["LagEstimate", "estimate_lag", "SlipRepair", "repair_ttl_slips"]
 
 class LagEstimate(NamedTuple):
     """``lag_s`` (s; positive when ``y`` lags ``x``, i.e. y(t) ≈ x(t − lag)), ``lag_samples``
-    (in samples of ``fs``), ``correlation`` (normalised correlation at the lag)."""
+    (in samples of ``fs``), ``correlation`` (normalised correlation at the lag).
+    """
 
     lag_s: float
     lag_samples: float
@@ -138,7 +139,8 @@ def estimate_lag(
 class SlipRepair(NamedTuple):
     """``mocap`` aligned mocap samples, one per IMU sample of ``imu_index``; ``imu_index``
     (M,) IMU sample indices covered (from the first to the last timestamp); ``n_duplicated``
-    and ``n_deleted`` cycle corrections; ``cycle_lengths`` IMU samples between timestamps."""
+    and ``n_deleted`` cycle corrections; ``cycle_lengths`` IMU samples between timestamps.
+    """
 
     mocap: np.ndarray
     imu_index: np.ndarray

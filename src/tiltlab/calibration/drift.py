@@ -158,7 +158,8 @@ def drift_slope(
 
 class DriftCorrection(NamedTuple):
     """``angle`` (N, 3) corrected integrated angle (°; a DataArray for labelled input),
-    ``slope`` (3,) removed rate (°/s), ``method``."""
+    ``slope`` (3,) removed rate (°/s), ``method``.
+    """
 
     angle: np.ndarray
     slope: np.ndarray
@@ -291,7 +292,8 @@ def allan_deviation(
 class AllanNoise(NamedTuple):
     """``arw`` angle random walk (rate unit·√s, e.g. °/√s — equal to the white-noise
     density in °/s/√Hz), ``bias_instability`` (rate unit), ``tau_min`` (s, where the
-    deviation is smallest), ``rrw`` rate random walk (rate unit/√s, NaN if no +1/2 slope)."""
+    deviation is smallest), ``rrw`` rate random walk (rate unit/√s, NaN if no +1/2 slope).
+    """
 
     arw: np.ndarray
     bias_instability: np.ndarray

@@ -342,7 +342,8 @@ def detect_static(
 
 class StaticStats(NamedTuple):
     """Per-period statistics: ``mean`` (P, 3), ``sem`` (P, 3) standard error of the mean,
-    ``std`` (P, 3) and ``n`` (P,) sample counts."""
+    ``std`` (P, 3) and ``n`` (P,) sample counts.
+    """
 
     mean: np.ndarray
     sem: np.ndarray

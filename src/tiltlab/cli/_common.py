@@ -1,5 +1,6 @@
 """Shared pieces of the command line: exit statuses, the one-line user error, loading a
-source and reading options."""
+source and reading options.
+"""
 
 from __future__ import annotations
 
@@ -95,7 +96,8 @@ def _load(
 ):
     """A Recording from a data-source string, or from a CSV with a mapping.
 
-    A refusal of the unit check names ``--no-check-units``."""
+    A refusal of the unit check names ``--no-check-units``.
+    """
     from .. import datasets, io
     from ..quality import UnitCheckError
 

@@ -68,7 +68,8 @@ _SUMMARY_HEAD = re.compile(r"\d+ sessions: \d+ ok, \d+ failed")
 class _WithoutRunSummary:
     """stderr during :func:`tiltlab.cohort.run_cohort`: everything passes (the progress
     bar, warnings) except the summary the run prints at its end, which ``cohort run``
-    prints itself, once, on stdout."""
+    prints itself, once, on stdout.
+    """
 
     def __init__(self, stream):
         self._stream = stream
@@ -274,7 +275,8 @@ def _cmd_cohort_run(args: argparse.Namespace) -> int:
 
 def _save_tables(features, out: Path) -> tuple[Path, Path]:
     """Write ``<out stem>.csv`` (with its ``.columns.csv``) and ``.parquet`` beside
-    the NetCDF feature file."""
+    the NetCDF feature file.
+    """
     from .. import cohort
 
     table = cohort.to_table(features)
@@ -326,7 +328,8 @@ MAIN_FEATURES = (
 
 def _feature_table(features, max_features: int | None):
     """Sessions × (labels, status, main features) as a DataFrame; units of the shown
-    features; names of the features left out."""
+    features; names of the features left out.
+    """
     import pandas as pd
 
     labels = [

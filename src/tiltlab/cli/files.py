@@ -40,7 +40,8 @@ def _quality_lines(emit):
     """Collect the warnings of tiltlab (quality warnings and any other warning raised in
     the package) while the block runs, and hand each distinct message, in order, to
     ``emit`` when it ends — also when it ends by an error. Other warnings (libraries')
-    are shown as usual."""
+    are shown as usual.
+    """
     package = str(Path(__file__).resolve().parent)
     lines: list[str] = []
     try:
@@ -88,7 +89,8 @@ def _checksums(source: str, what: str | None) -> str | None:
     ``"none stored"``; None for any other source.
 
     Called once the file has loaded, which verified the checksums it holds (a
-    mismatch has been raised as an :class:`~tiltlab.io.IntegrityError`)."""
+    mismatch has been raised as an :class:`~tiltlab.io.IntegrityError`).
+    """
     from .. import io
 
     if what is None or not what.startswith("tiltlab Recording"):

@@ -49,7 +49,8 @@ def _dry_run(method, params: dict, use_mag: bool, where: str = "method_params") 
     """Run ``method`` on a short synthetic static input, so that an out-of-domain
     parameter (a negative cut-off, a NaN gain) is refused when the configuration is
     built, not once per session. Only errors naming a parameter count (the synthetic
-    input is valid); the adapters to other packages are not run."""
+    input is valid); the adapters to other packages are not run.
+    """
     if method.kind == "adapter":
         return
     n = 32
@@ -68,7 +69,8 @@ def _dry_run(method, params: dict, use_mag: bool, where: str = "method_params") 
 
 def _resolved(method: Any, params: Any, where: str):
     """The registry entry of ``method`` and its parameters completed with the defaults,
-    typed (a numeric parameter is a finite float) and JSON-serialisable."""
+    typed (a numeric parameter is a finite float) and JSON-serialisable.
+    """
     name = f"FeatureConfig.{where}"
     pname = f"FeatureConfig.{where}_params"
     if not isinstance(method, str):

@@ -231,7 +231,8 @@ def _tumble(cal, config: FeatureConfig):
 def _corrected(rec: xr.Dataset, config: FeatureConfig, calibration, notes=None):
     """Calibrated Recording and the session gyro offset removed (°/s; NaN when it
     could not be estimated, e.g. sustained rotation throughout: then nothing is
-    removed and ``notes`` gets the reason)."""
+    removed and ``notes`` gets the reason).
+    """
     stacked = False
     if calibration is not None:
         cal = _tumble(calibration, config)
@@ -293,7 +294,8 @@ def session_tilt(
 
 def _tilt_method(rec: xr.Dataset, config: FeatureConfig) -> tuple[str, dict, bool]:
     """The method, parameters and ``use_mag`` for this Recording: ``config.method``
-    when the Recording has what it needs, else ``config.no_gyro_method``."""
+    when the Recording has what it needs, else ``config.no_gyro_method``.
+    """
     have = {v for v in _filters.SENSORS if v in rec}
     if set(_filters.get_method(config.method).needs) <= have:
         return config.method, config.method_params, config.use_mag
@@ -302,7 +304,8 @@ def _tilt_method(rec: xr.Dataset, config: FeatureConfig) -> tuple[str, dict, boo
 
 def _tilt(rec: xr.Dataset, config: FeatureConfig) -> xr.DataArray:
     """Gravity-up direction of a corrected Recording with the configured method (or,
-    without the sensors it needs, ``config.no_gyro_method``)."""
+    without the sensors it needs, ``config.no_gyro_method``).
+    """
     method, params, use_mag = _tilt_method(rec, config)
     with warnings.catch_warnings():  # the features record the gaps themselves
         warnings.filterwarnings("ignore", r"estimate\(.*gaps='segments'")

@@ -58,7 +58,8 @@ _FIELD = re.compile(r"\{(\w+)\}")
 def _pattern_regex(pattern: str) -> tuple[re.Pattern, list[str]]:
     """The regular expression of a pattern (see :data:`PATTERN_HELP`) and its fields.
 
-    Each field becomes a greedy ``[^/]+`` (a field named again, a back-reference)."""
+    Each field becomes a greedy ``[^/]+`` (a field named again, a back-reference).
+    """
     if not pattern.strip():
         raise ValueError("the pattern is empty; give e.g. '{group}/{subject}.nc'")
     if pattern.startswith("/"):
@@ -121,7 +122,8 @@ def _user_regex(regex: str | re.Pattern) -> tuple[re.Pattern, list[str]]:
 def _broad_layout(path: Path) -> bool:
     """True for an HDF5 file with the variables of a BROAD trial (which
     :func:`tiltlab.io.detect` may describe as a NetCDF-4 file, h5netcdf opening any
-    HDF5 file)."""
+    HDF5 file).
+    """
     import h5py
 
     from ..io.broad import _BROAD_VARS
@@ -136,7 +138,8 @@ def _broad_layout(path: Path) -> bool:
 
 def _reader_from_content(path: Path, label: str) -> str:
     """The reader of a file, chosen from its content (:func:`tiltlab.io.detect`);
-    a file of another kind is refused, listing the readers to choose from."""
+    a file of another kind is refused, listing the readers to choose from.
+    """
     choices = ", ".join(r for r in READERS if r != "auto")
     try:
         with warnings.catch_warnings():  # a probe: the reader warns when it reads

@@ -102,7 +102,8 @@ OPTIONAL_COLUMNS: tuple[str, ...] = ("reader_options", "calibration")
 
 class ManifestWarning(UserWarning):
     """A manifest that is valid but looks wrong (e.g. two group labels one letter
-    apart)."""
+    apart).
+    """
 
 
 @dataclass(frozen=True)
@@ -170,7 +171,8 @@ class Manifest:
 
 def _portable(path, base) -> str:
     """``path`` relative to the folder ``base`` (POSIX separators), or absolute when no
-    relative path exists (another drive)."""
+    relative path exists (another drive).
+    """
     try:
         return Path(os.path.relpath(path, base)).as_posix()
     except ValueError:
@@ -221,7 +223,8 @@ def _maybe_numeric(col: pd.Series) -> pd.Series:
 
 def _declared_names(names, what: str) -> list[str] | None:
     """A study's declared groups or time points: a sequence, or one comma-separated
-    string; None when not declared."""
+    string; None when not declared.
+    """
     if names is None:
         return None
     if isinstance(names, str):
@@ -271,7 +274,8 @@ def _same_content(paths: Sequence[str]) -> tuple[int, int] | None:
     """The first ``(j, i)``, ``j < i``, of two existing files with the same bytes.
 
     Only files of equal size are read: first three sampled blocks, and the whole file
-    (SHA-256) only where those agree. Files that cannot be read are left out."""
+    (SHA-256) only where those agree. Files that cannot be read are left out.
+    """
     by_size: dict[int, list[int]] = {}
     for i, p in enumerate(paths):
         try:
@@ -314,7 +318,8 @@ def _check_table(
     """Validate and normalise a manifest table (all cells strings); returns a new one.
 
     Rows are named ``"<name>, line N"`` (``N`` 1-based with the header as line 1), or
-    by ``labels[i]`` when given (a table that is not a file yet)."""
+    by ``labels[i]`` when given (a table that is not a file yet).
+    """
     missing = [c for c in REQUIRED_COLUMNS if c not in df.columns]
     if missing:
         raise ManifestError(
@@ -491,7 +496,8 @@ def _warn_near_duplicates(column, what: str, keyword: str, where: str) -> None:
     """Warn when two labels of a column differ by a letter or two (``translaton`` next
     to ``translation``): likely a typo that would make a group or time point of its
     own. Only a warning: labels such as ``d1``/``d7`` are close on purpose; declaring
-    the labels (``keyword``) makes an undeclared one an error."""
+    the labels (``keyword``) makes an undeclared one an error.
+    """
     counts = column.astype(str).value_counts()
     labels = list(counts.index)
     for i, a in enumerate(labels):

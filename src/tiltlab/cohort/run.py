@@ -237,7 +237,8 @@ def _cache_get(cache: Path, key: str | None, names) -> xr.Dataset | None:
 def _write_atomically(path, write: Callable[[Path], object]) -> Path:
     """Call ``write(tmp)`` on a temporary file beside ``path``, then rename it into
     place (:func:`os.replace`): a reader sees the old file or the new one, never half
-    of one, and a failed ``write`` leaves no temporary file behind."""
+    of one, and a failed ``write`` leaves no temporary file behind.
+    """
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     tmp = path.with_name(f".{path.name}.{os.getpid()}.{uuid.uuid4().hex}.tmp")
@@ -474,7 +475,8 @@ def run_cohort(
 @dataclass(frozen=True)
 class CohortSummary:
     """Outcome of a cohort run: counts, per failed session the reason, and per session
-    that ran with NaN features why they are NaN."""
+    that ran with NaN features why they are NaN.
+    """
 
     n_sessions: int
     n_ok: int

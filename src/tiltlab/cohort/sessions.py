@@ -45,7 +45,8 @@ def _read_netcdf(
     check_units: bool = True,
 ) -> xr.Dataset:
     """A NetCDF Recording (:func:`tiltlab.io.load_netcdf`), validated with these
-    options of :func:`tiltlab.schema.validate`."""
+    options of :func:`tiltlab.schema.validate`.
+    """
     kw = {"max_jitter": max_jitter, "quat_atol": quat_atol, "check_units": check_units}
     if allow_nan is not None:
         kw["allow_nan"] = allow_nan
@@ -68,7 +69,8 @@ _CALIBRATION_READERS = {".nc": "netcdf", ".netcdf": "netcdf", ".csv": "fayat_tum
 
 class ManifestError(ValueError):
     """A manifest is malformed; the message names the line (or, for
-    :func:`~tiltlab.cohort.init_manifest`, the file) and the session."""
+    :func:`~tiltlab.cohort.init_manifest`, the file) and the session.
+    """
 
 
 def _options(text: str, reader: str, where: str) -> dict[str, Any]:

@@ -114,7 +114,8 @@ def init_samples(init_window_s: float, fs: float) -> int:
 
 def start_orientation(q0, acc, mag, fs: float, init_window_s: float) -> np.ndarray:
     """The initial orientation: ``q0`` normalised, or :func:`initial_orientation` of the
-    first ``init_window_s`` seconds of ``acc`` (and ``mag``)."""
+    first ``init_window_s`` seconds of ``acc`` (and ``mag``).
+    """
     n = init_samples(init_window_s, fs)
     if q0 is None:
         return initial_orientation(acc[:n], None if mag is None else mag[:n])
@@ -128,7 +129,8 @@ def start_orientation(q0, acc, mag, fs: float, init_window_s: float) -> np.ndarr
 
 def tilt_quaternion(g) -> np.ndarray:
     """Minimal rotations (zero heading part) taking unit vectors ``g`` (sensor) to e_z
-    (world); ``g = -e_z`` gives the half turn about x."""
+    (world); ``g = -e_z`` gives the half turn about x.
+    """
     g = np.asarray(g, float)
     q = np.stack(
         [1.0 + g[..., 2], g[..., 1], -g[..., 0], np.zeros(g.shape[:-1])], axis=-1
@@ -260,7 +262,8 @@ def _read_labelled(a, name: str, fs: float | None, acc_si: bool) -> _v.Signal:
 def _time_agrees(a, name: str, fs: float) -> None:
     """Refuse an ``fs`` argument that contradicts the ``time`` coordinate of a labelled
     input without an ``fs`` attribute (as :func:`tiltlab._validate.signal` does for the
-    attribute)."""
+    attribute).
+    """
     da = a[name] if isinstance(a, xr.Dataset) and name in a else a
     if not isinstance(da, xr.DataArray) or "time" not in da.coords:
         return

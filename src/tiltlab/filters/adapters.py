@@ -93,7 +93,7 @@ def run_vqf(acc, gyr, fs: float | None = None, *, mag=None, **vqf_params) -> np.
 def run_offline_vqf(
     acc, gyr, fs: float | None = None, *, mag=None, **vqf_params
 ) -> np.ndarray:
-    """offlineVQF (``vqf.offlineVQF``, non-causal), 6D or 9D; ``vqf_params`` as for
+    """OfflineVQF (``vqf.offlineVQF``, non-causal), 6D or 9D; ``vqf_params`` as for
     :func:`run_vqf`.
 
     Parameters

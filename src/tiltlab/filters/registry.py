@@ -161,7 +161,8 @@ class Method:
     @property
     def needs(self) -> tuple[str, ...]:
         """The Recording variables the method cannot run without (``acc`` always,
-        ``gyr`` when it integrates the gyroscope, ``mag`` when it requires one)."""
+        ``gyr`` when it integrates the gyroscope, ``mag`` when it requires one).
+        """
         return (
             ("acc",)
             + (("gyr",) if self.uses_gyr else ())

@@ -79,7 +79,8 @@ def _missing_columns_message(
 
 def read_table_or_fail(path, **kwargs) -> pd.DataFrame:
     """:func:`pandas.read_csv`, its parse errors raised as one :class:`ReadError`
-    naming the file."""
+    naming the file.
+    """
     try:
         return pd.read_csv(path, **kwargs)
     except (

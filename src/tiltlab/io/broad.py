@@ -67,7 +67,8 @@ def _check_layout(path: Path, data: dict[str, np.ndarray]) -> int:
 
 def _movement_mask(path: Path, movement: np.ndarray) -> np.ndarray:
     """BROAD's ``movement`` flags as booleans; anything but 0/1 (NaN included) is an
-    error naming the rows, never a silent ``True``."""
+    error naming the rows, never a silent ``True``.
+    """
     m = np.asarray(movement).reshape(-1)
     if m.dtype == bool:
         return m

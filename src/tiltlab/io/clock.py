@@ -74,7 +74,8 @@ _EPOCH_RANGE = (10 * 365.25 * 86400, 130 * 365.25 * 86400)
 
 def option_hint(key: str, value: Any, style: str) -> str:
     """An option as the user writes it: ``"clock": "resample"`` in a mapping (JSON),
-    ``clock='resample'`` as a keyword."""
+    ``clock='resample'`` as a keyword.
+    """
     if style == "mapping":
         return f"{json.dumps(key)}: {json.dumps(value)}"
     return f"{key}={value!r}"
@@ -105,7 +106,8 @@ def unit_hint(
     style: str = "python",
 ) -> str:
     """Which time unit (other than the one in use, factor ``scale`` to seconds) would
-    make ``raw_step`` (in the column's numbers) a plausible sampling interval."""
+    make ``raw_step`` (in the column's numbers) a plausible sampling interval.
+    """
     lo, hi = fs_range or FS_RANGE
     for unit, factor in TIME_UNITS.items():
         if scale is not None and np.isclose(factor, scale):

@@ -120,7 +120,8 @@ def _flat(name: Any) -> str:
 def _numeric(values: pd.Series, name: str, path: Path, raw_text=None) -> np.ndarray:
     """A column as numbers, refusing text, missing-value markers and empty fields
     with the data row. ``raw_text(row)``, if given, returns the field as written in
-    the file (pandas has already turned markers such as ``NaN`` or ``NA`` into NaN)."""
+    the file (pandas has already turned markers such as ``NaN`` or ``NA`` into NaN).
+    """
     num = pd.to_numeric(values, errors="coerce")
     bad = num.isna().to_numpy()
     if bad.any():
@@ -156,7 +157,8 @@ _NA_MARKERS = frozenset(
 
 def _raw_field(path: Path, kwargs: Mapping[str, Any], column: str):
     """A function ``row -> str``: the field of ``column`` as written in the file (read
-    again without missing-value conversion; used for error messages only)."""
+    again without missing-value conversion; used for error messages only).
+    """
 
     def get(row: int):
         try:
@@ -188,7 +190,8 @@ def read_frame(
 ) -> dict[str, np.ndarray]:
     """Read the ``wanted`` columns of a CSV: numbers (integers kept as integers), or
     the raw values for the columns in ``text``. A header of several rows is flattened
-    (levels joined with ``/``)."""
+    (levels joined with ``/``).
+    """
     if path.is_dir():
         raise ReadError(f"{path}: is a directory, not a file")
     if not path.is_file():
@@ -573,7 +576,8 @@ def build_recording(
     style: str,
 ) -> xr.Dataset:
     """:func:`tiltlab.schema.make_recording` with a mapping's options; a unit-check
-    error names the switch in the form the options were given."""
+    error names the switch in the form the options were given.
+    """
     units, full = m["units"], m["range"]
     try:
         return schema.make_recording(

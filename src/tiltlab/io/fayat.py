@@ -13,14 +13,16 @@ from ._common import PathLike, ReadError, _read_table
 
 def _existing_file(path: PathLike) -> None:
     """Refuse a directory given where a file is expected (a missing file is refused
-    by the table reader)."""
+    by the table reader).
+    """
     if Path(path).is_dir():
         raise ReadError(f"{path}: is a directory, not a file")
 
 
 def _counter(path: PathLike, column) -> np.ndarray:
     """The acquisition counter as int64; a non-integer value (a corrupted row) is an
-    error naming the row, never cut to an integer."""
+    error naming the row, never cut to an integer.
+    """
     values = column.to_numpy()
     if values.dtype.kind == "f":
         frac = values != np.floor(values)

@@ -1,6 +1,7 @@
 """Checking the column/unit mappings of :func:`tiltlab.io.read_csv` and
 :func:`tiltlab.io.read_multi`: every key is checked here, once, and every message names
-the key and the fix."""
+the key and the fix.
+"""
 
 from __future__ import annotations
 
@@ -72,7 +73,8 @@ def read_csv_params() -> frozenset[str]:
 
 def scaled_unit_hint(var: str, unit: object) -> str:
     """A hint for a unit that is a known one with a prefix (``mg``, ``mdps``) or raw
-    ADC counts: read the column with a ``scale`` factor instead."""
+    ADC counts: read the column with a ``scale`` factor instead.
+    """
     if not isinstance(unit, str):
         return ""
     key = unit.strip()
@@ -139,7 +141,8 @@ def check_time_unit(
 ) -> tuple[float | None, str | None]:
     """The time column's unit from ``time_units``, ``time_scale`` (and ``extra``, a
     ``units['time']``): the factor to seconds (None for date-times) and the unit's
-    name."""
+    name.
+    """
     sources = {
         k: v
         for k, v in (("time_units", raw.get("time_units")), ("units['time']", extra))
@@ -348,7 +351,8 @@ def check_columns(columns: Any, where: str) -> dict[str, list[str]]:
 
 def check_mapping(raw: Mapping[str, Any], where: str) -> dict[str, Any]:
     """Check a raw one-file mapping and return it normalised (see
-    :func:`tiltlab.io.read_csv_mapping`)."""
+    :func:`tiltlab.io.read_csv_mapping`).
+    """
     allowed_read = read_csv_params()
     unknown = [k for k in raw if k not in MAPPING_KEYS and k not in allowed_read]
     if unknown:

@@ -56,7 +56,8 @@ def _variable_digest(var: xr.Variable) -> str:
 
     Numbers are hashed as their little-endian bytes (NaNs made canonical, so a NaN's
     payload does not count), times as int64 nanoseconds, text as UTF-8 JSON (str and
-    bytes alike, as NetCDF gives either back)."""
+    bytes alike, as NetCDF gives either back).
+    """
     a = np.asarray(var.values)
     kind = a.dtype.kind
     if kind in "biufc":
@@ -242,7 +243,8 @@ def save_netcdf(ds: xr.Dataset, path: PathLike) -> Path:
 
 class NotRecordingError(ReadError):
     """A readable file that is not a tiltlab Recording; the message says what it looks
-    like and how to convert it."""
+    like and how to convert it.
+    """
 
     def __init__(self, path: PathLike, looks_like: str):
         self.path = Path(path)

@@ -163,7 +163,7 @@ def _samples_first(var: xr.DataArray, path: Path, width: int | None) -> np.ndarr
 
 
 def _axes_spec(letters: str, name: str, path: Path) -> list[str]:
-    """tiltlab axes (``["x", "-y", "z"]``) from a tag-tools axes attribute (``"FRU"``)."""
+    """Tiltlab axes (``["x", "-y", "z"]``) from a tag-tools axes attribute (``"FRU"``)."""
     code = letters.strip().upper()
     placed: dict[int, str] = {}
     if len(code) == 3 and all(c in _LETTERS for c in code):

@@ -139,7 +139,8 @@ def sequence(
 
 def window_ends(seq: Sequence, window: int, stride: int = 1) -> np.ndarray:
     """Indices ``t`` (every ``stride``-th) whose window ``t-window..t`` has a finite
-    reference at both ends (training targets and initial orientations)."""
+    reference at both ends (training targets and initial orientations).
+    """
     window = int(_v.integer(window, "window", minimum=1))
     stride = int(_v.integer(stride, "stride", minimum=1))
     if seq.q_ref is None:

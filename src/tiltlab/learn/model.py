@@ -104,7 +104,8 @@ class OrientationCNN(nn.Module):
     ) -> torch.Tensor:
         """``x``: (B, 10, T) with the gyro quaternions in channels 0–3; ``q_vec``:
         (B, 4), the vector-observation orientation at the window's end (``gain``
-        variant only)."""
+        variant only).
+        """
         h = self.body(x).flatten(1)
         out = self.last(self.head(h))
         q_w = x[:, :4, -1]

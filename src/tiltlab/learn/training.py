@@ -210,7 +210,8 @@ def _inputs(
     window: int,
 ) -> torch.Tensor:
     """(B, 10, T) network inputs for windows ending at ``ends`` (windowed ``acc_w`` and
-    ``mag_w``, (B, T, 3)) from initial orientations ``q0`` (B, 4) at ``ends - window``."""
+    ``mag_w``, (B, T, 3)) from initial orientations ``q0`` (B, 4) at ``ends - window``.
+    """
     dq = qmul(_conj(Q[ends - window])[:, None, :], Q[_indices(ends, window)])
     q_w = qmul(_canonical(q0)[:, None, :], dq)
     return torch.cat([q_w, acc_w, mag_w], dim=-1).transpose(1, 2)
@@ -506,7 +507,8 @@ def read_sums(path: str | Path) -> dict[str, str]:
 
 def _state_digest(blob: dict[str, Any]) -> str:
     """SHA-256 of what a model file holds: configuration, ``fs`` and every tensor's
-    name, dtype, shape and bytes."""
+    name, dtype, shape and bytes.
+    """
     h = hashlib.sha256()
     head = {"config": blob["config"], "fs": float(blob["fs"])}
     h.update(json.dumps(head, sort_keys=True, default=str).encode() + b"\0")

@@ -1,5 +1,6 @@
 """Shared pieces of the quality checks: thresholds, the finding record, the unit-check
-error and the reading of a variable with its units."""
+error and the reading of a variable with its units.
+"""
 
 from __future__ import annotations
 
@@ -133,7 +134,8 @@ def _raw_dtype(x, var: str):
 
 def _read(x, name: str, *, units: str | None = None, need_units: bool = True):
     """Values (2-D, float, NaN kept), canonical units (or None), variable attrs, fs, and
-    whether the input had an integer dtype."""
+    whether the input had an integer dtype.
+    """
     kind = _raw_dtype(x, name).kind
     if isinstance(x, xr.Dataset):
         # a Recording's variables: read directly (its time/fs consistency and shapes are

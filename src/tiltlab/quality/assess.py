@@ -28,7 +28,8 @@ from .unitcheck import (
 
 def plausibility(ds: xr.Dataset) -> list[Finding]:
     """Every plausibility finding of a Recording: raw counts, accelerometer and gyroscope
-    units, temperature (see the ``check_*`` functions). NaN samples are ignored."""
+    units, temperature (see the ``check_*`` functions). NaN samples are ignored.
+    """
     out: list[Finding] = []
     counts = set()
     for name in _VECTORS:
@@ -56,7 +57,8 @@ def assess(
     ds: xr.Dataset, *, units: bool = True, saturation: bool = True
 ) -> list[Finding]:
     """All quality findings of a Recording (plausibility, then saturation), without
-    raising or warning. ``units`` / ``saturation`` select the checks."""
+    raising or warning. ``units`` / ``saturation`` select the checks.
+    """
     out: list[Finding] = []
     if units:
         out += plausibility(ds)
@@ -67,7 +69,8 @@ def assess(
 
 def _stacklevel() -> int:
     """The stack level of the first caller outside tiltlab, for :func:`warnings.warn`
-    called from :func:`emit`."""
+    called from :func:`emit`.
+    """
     pkg = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))  # tiltlab
     frame = sys._getframe(1)  # emit
     level = 1
@@ -81,7 +84,8 @@ def _stacklevel() -> int:
 
 def emit(findings: Sequence[Finding]) -> None:
     """Raise :class:`RecordingError` with every error's message (joined by ``"; "``),
-    else warn each warning as a :class:`QualityWarning`."""
+    else warn each warning as a :class:`QualityWarning`.
+    """
     errors = [f for f in findings if f.is_error]
     if errors:
         raise UnitCheckError(errors)

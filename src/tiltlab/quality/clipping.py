@@ -40,7 +40,8 @@ def full_scale(attrs_or_da, name: str = "the variable") -> tuple[float, float] |
 
 def limits(value, what: str = "limit", error=ValueError) -> tuple[float, float]:
     """A full scale as ``(low, high)``: ``r`` (a positive number) means ±r, a pair must
-    have ``low < 0 < high``; anything else raises ``error`` naming ``what``."""
+    have ``low < 0 < high``; anything else raises ``error`` naming ``what``.
+    """
     bad = error(
         f"{what} must be a positive full scale r (for ±r) or [low, high] with "
         f"low < 0 < high, in the variable's units; got {value!r}"
@@ -102,7 +103,8 @@ def _observed_rail(v: np.ndarray, min_run: int) -> float | None:
 def _repeat_rate(col: np.ndarray, top: np.ndarray, near: np.ndarray) -> float:
     """How often the signal repeats its previous value: on consecutive samples just below
     the maximum (``near`` and not ``top``) when there are at least 10 such pairs, else on
-    the whole axis outside the maximum (a sample-and-hold signal repeats everywhere)."""
+    the whole axis outside the maximum (a sample-and-hold signal repeats everywhere).
+    """
     for sel in (near & ~top, ~top):
         pair = sel[1:] & sel[:-1] & np.isfinite(col[1:]) & np.isfinite(col[:-1])
         if pair.sum() >= 10:
@@ -219,7 +221,8 @@ def saturation(
 
 def _attr_limit(v: np.ndarray, attrs, name: str):
     """The full scale of the ``range`` attribute, or None when absent or stale (the data
-    exceed it by more than 5 %); and the peak |value| when stale, else None."""
+    exceed it by more than 5 %); and the peak |value| when stale, else None.
+    """
     lim = full_scale(attrs, repr(name))
     if lim is None:
         return None, None

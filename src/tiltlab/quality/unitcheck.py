@@ -1,5 +1,6 @@
 """Are the values plausible for their unit labels? Accelerometer, gyroscope and
-temperature checks (the gyroscope against the tilt the accelerometer sees)."""
+temperature checks (the gyroscope against the tilt the accelerometer sees).
+"""
 
 from __future__ import annotations
 
@@ -92,7 +93,8 @@ def _smoothed_directions(
     acc: np.ndarray, w: int, tol: float
 ) -> tuple[np.ndarray, np.ndarray]:
     """Unit directions of the acceleration averaged over ``w`` samples (centred), and
-    whether each is gravity-dominated (its magnitude within ``tol`` of the median)."""
+    whether each is gravity-dominated (its magnitude within ``tol`` of the median).
+    """
     a = np.where(np.isfinite(acc), acc, 0.0)
     c = np.cumsum(np.vstack([np.zeros((1, 3)), a]), axis=0)
     n = a.shape[0]
@@ -125,7 +127,8 @@ def _rotation_bound(
     about and the gyroscope's (perpendicular to gravity) in those windows: the |median
     signed cosine|. The angle between two gravity directions is at most the rotation
     integrated between them, so a correctly labelled gyroscope explains every window,
-    whatever its bias or noise."""
+    whatever its bias or noise.
+    """
     n = gyr_rad_s.shape[0]
     w = max(1, int(round(0.25 * fs)))  # direction smoothing (vibration, noise)
     step = max(1, int(round(GYR_WINDOW_S * fs)))
@@ -297,7 +300,8 @@ def check_gyr_units(
 def _tilt_span(acc: np.ndarray, fs: float) -> float | None:
     """A lower bound (rad) of how far the gravity direction seen by the accelerometer
     turns: the angle between two of its directions, smoothed over 0.5 s and taken on
-    samples whose magnitude is within 10 % of the median (gravity-dominated)."""
+    samples whose magnitude is within 10 % of the median (gravity-dominated).
+    """
     a = _finite_rows(acc)
     w = max(1, int(round(0.5 * fs)))
     if a.shape[0] < 2 * w:

@@ -1,5 +1,6 @@
 """Quaternion algebra: identity, product, conjugate, inverse, norm, rotation of
-vectors, and conversions to and from matrices, rotation vectors, exp and log."""
+vectors, and conversions to and from matrices, rotation vectors, exp and log.
+"""
 
 from __future__ import annotations
 

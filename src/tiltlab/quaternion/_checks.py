@@ -9,7 +9,8 @@ import numpy as np
 
 def _real(a, name: str) -> np.ndarray:
     """``a`` as a float array; complex input is refused by name (never cut to its
-    real part)."""
+    real part).
+    """
     raw = np.asarray(a)
     if raw.dtype.kind == "c":
         raise ValueError(
@@ -75,7 +76,8 @@ def check_unit(q: np.ndarray, name: str = "q", atol: float = 1e-6) -> None:
 
 def check_rotation(m: np.ndarray, name: str = "m", atol: float = 1e-6) -> None:
     """Raise unless every finite (3, 3) matrix of ``m`` is a proper rotation
-    (orthonormal within ``atol``, determinant +1). NaN matrices pass; infinities do not."""
+    (orthonormal within ``atol``, determinant +1). NaN matrices pass; infinities do not.
+    """
     if np.any(np.isinf(m)):
         raise ValueError(f"{name} has infinite values")
     M = m[np.all(np.isfinite(m), axis=(-2, -1))]

@@ -1,5 +1,6 @@
 """Tilt and orientation errors: gravity direction, angle between vectors, error
-quaternion and the total / heading / tilt error angles."""
+quaternion and the total / heading / tilt error angles.
+"""
 
 from __future__ import annotations
 

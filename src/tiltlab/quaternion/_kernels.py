@@ -1,5 +1,6 @@
 """Numba kernels of :mod:`tiltlab.quaternion`: the inlined scalar helpers (also used by
-tiltlab.filters and tiltlab.simulate) and the array loops behind the public wrappers."""
+tiltlab.filters and tiltlab.simulate) and the array loops behind the public wrappers.
+"""
 
 from __future__ import annotations
 
@@ -39,7 +40,7 @@ def rotvec_to_quat_scalar(rx, ry, rz):
 
 @njit(cache=True, inline="always")
 def zoh_step_scalar(w, x, y, z, rx, ry, rz):
-    """q ⊗ exp(r / 2) for the rotation vector r = ω Δt (not renormalised)."""
+    """Q ⊗ exp(r / 2) for the rotation vector r = ω Δt (not renormalised)."""
     dw, dx, dy, dz = rotvec_to_quat_scalar(rx, ry, rz)
     return qmul_scalar(w, x, y, z, dw, dx, dy, dz)
 

@@ -1,5 +1,6 @@
 """What a report runs: the book's chapters, the source's kind, and which parameter
-of each chapter receives it; the records of what ran."""
+of each chapter receives it; the records of what ran.
+"""
 
 from __future__ import annotations
 
@@ -44,7 +45,8 @@ Status = Literal["ran", "failed", "not run"]
 
 class ReportError(ValueError):
     """A report that cannot start (a bad source, chapter list, parameter, book folder
-    or output folder) or whose pages cannot be rendered; the message says what to do."""
+    or output folder) or whose pages cannot be rendered; the message says what to do.
+    """
 
 
 @dataclass
@@ -336,7 +338,8 @@ def _plan(
     ch: _Chapter, source: _Source, recording: _Source | None, given: Iterable[str]
 ) -> tuple[dict[str, Any], str | None]:
     """The source parameters of one chapter, or why it does not run (a chapter whose
-    source parameter the user gave, ``given``, runs with it)."""
+    source parameter the user gave, ``given``, runs with it).
+    """
     rec_names = _source_parameters(ch, RECORDING_PARAMETERS, _RECORDING_DEFAULT)
     man_names = _source_parameters(ch, MANIFEST_PARAMETERS, _MANIFEST_DEFAULT)
     if source.kind == "manifest":
@@ -365,7 +368,8 @@ def _plan(
 
 def _absolute_if_file(value: Any) -> Any:
     """A relative path to an existing file or folder, made absolute (chapters run in
-    their own folder); any other value as it is."""
+    their own folder); any other value as it is.
+    """
     if isinstance(value, str) and value and not os.path.isabs(value):
         with_path = Path(value).expanduser()
         try:

@@ -1,5 +1,6 @@
 """The report's pages: an index, the executed chapters and the book's look, built with
-jupyter-book."""
+jupyter-book.
+"""
 
 from __future__ import annotations
 
@@ -179,7 +180,8 @@ def _copy_book_files(
     book: Path | None, dest: Path, config: dict[str, Any]
 ) -> list[str]:
     """Copy what the configuration names (style, extension, bibliography, vendored
-    MathJax) and the reference pages; return the pages copied."""
+    MathJax) and the reference pages; return the pages copied.
+    """
     if book is None:
         return []
     for name in ("_static", "_ext", "_templates"):
@@ -208,7 +210,8 @@ _DOC_ROLE = re.compile(r"\{doc\}`([^`<]*?)\s*(?:<([^`>]+)>)?`")
 
 def _unlink(text: str, keep: set[str], titles: Mapping[str, str]) -> str:
     """``{doc}`` references to pages the report does not have (the chapters not run, a
-    reference page not copied) as plain text: the label, or the chapter's title."""
+    reference page not copied) as plain text: the label, or the chapter's title.
+    """
 
     def replace(m: re.Match) -> str:
         label, target = m[1].strip(), (m[2] or m[1]).strip()
@@ -231,7 +234,8 @@ def _page_copy(
 ) -> None:
     """The executed notebook as a page of the report: its number before its title (the
     report's pages are not numbered by position, as the book's are), and references to
-    pages the report lacks as plain text."""
+    pages the report lacks as plain text.
+    """
     nb = json.loads(notebook.read_text(encoding="utf-8"))
     numbered = False
     for cell in nb.get("cells", []):

@@ -219,7 +219,8 @@ class CohortDesign:
     def select(self, *, groups: dict | None = None, time_points=None) -> "CohortDesign":
         """This design restricted to some time points (effect tables cut to match) and
         with other group sizes (``groups``: name → number of animals, names from
-        ``effects``)."""
+        ``effects``).
+        """
         tps = list(self.time_points if time_points is None else time_points)
         unknown = [t for t in tps if t not in self.time_points]
         if unknown:
@@ -597,7 +598,8 @@ def simulate_cohort(
 @dataclass
 class Cohort:
     """A cohort directory: ``sessions`` table, planted ``truth`` (None for real data),
-    ``design`` metadata."""
+    ``design`` metadata.
+    """
 
     path: Path
     sessions: pd.DataFrame

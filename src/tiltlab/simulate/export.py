@@ -1,5 +1,6 @@
 """A Recording written the way a phone logging app exports it: one CSV per sensor, each on
-its own jittery clock with nanosecond epoch times (:func:`phone_export`)."""
+its own jittery clock with nanosecond epoch times (:func:`phone_export`).
+"""
 
 from __future__ import annotations
 
@@ -24,7 +25,8 @@ PHONE_FILES = {
 def _stream_times(t0: float, t1: float, fs: float, rng, drift: float, jitter: float):
     """Sample times of one stream in [t0, t1]: its own rate (``fs`` off by up to
     ``drift``), its own start within the first period, and Gaussian jitter of
-    ``jitter`` periods (kept increasing)."""
+    ``jitter`` periods (kept increasing).
+    """
     rate = fs * (1.0 + rng.uniform(-drift, drift))
     start = t0 + rng.uniform(0.0, 1.0 / rate)
     n = int(np.floor((t1 - start) * rate)) + 1

@@ -48,7 +48,8 @@ __all__ = [
 class MarkerSupport:
     """Rigid marker support. ``markers_mm``: nominal marker positions in the head
     (= sensor) frame, mm, rows = markers 1..4; ``misalign_deg``: standard deviation of
-    the random rotation between the marker frame and the IMU axes."""
+    the random rotation between the marker frame and the IMU axes.
+    """
 
     markers_mm: tuple = (
         (0.0, 16.0, 30.0),

@@ -163,7 +163,8 @@ class SensorModel:
     @classmethod
     def ideal(cls, *, magnetometer: bool = False) -> "SensorModel":
         """A perfect sensor: no offset, scale, misalignment, noise, drift, temperature
-        effect, saturation or quantisation (measured = true)."""
+        effect, saturation or quantisation (measured = true).
+        """
         z, e = (0.0, 0.0, 0.0), ((0.0,) * 3,) * 3
         return cls(
             acc_offset=z,

@@ -21,7 +21,8 @@ __all__ = ["Track", "simulate_track", "simulate_heave"]
 
 class Track(NamedTuple):
     """A simulated 3-D path: positions (n+1, 3) in m, per-step speed (m/s), azimuth and
-    elevation (rad), step duration ``dt_s`` (s)."""
+    elevation (rad), step duration ``dt_s`` (s).
+    """
 
     positions: np.ndarray
     speed: np.ndarray

@@ -50,7 +50,8 @@ __all__ = ["Residence", "passage_times", "residence", "residence_series"]
 class Residence(NamedTuple):
     """Per centre: ``total`` time inside the cap (s), ``n_visits``, ``mean_residence``
     (total / n_visits, NaN when never visited) and ``residence`` (residence time of the
-    visit containing the reference time; NaN when none given or not inside then)."""
+    visit containing the reference time; NaN when none given or not inside then).
+    """
 
     total: np.ndarray
     n_visits: np.ndarray

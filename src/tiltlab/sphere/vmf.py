@@ -64,7 +64,8 @@ __all__ = [
 
 class VMFFit(NamedTuple):
     """Maximum-likelihood vMF fit: mean direction ``mu`` (3,), concentration ``kappa``,
-    mean resultant length ``rbar`` and total weight ``n``."""
+    mean resultant length ``rbar`` and total weight ``n``.
+    """
 
     mu: np.ndarray
     kappa: float
@@ -74,7 +75,8 @@ class VMFFit(NamedTuple):
 
 class ConfidenceCone(NamedTuple):
     """Bootstrap confidence cone around ``mu``: half-angle (rad) at ``level``, κ interval,
-    and the bootstrap angles between each replicate's mean and ``mu``."""
+    and the bootstrap angles between each replicate's mean and ``mu``.
+    """
 
     mu: np.ndarray
     kappa: float
@@ -319,7 +321,7 @@ def vmf_fit(x, weights=None) -> VMFFit:
 
 
 def vmf_logpdf(x, mu, kappa: float) -> np.ndarray:
-    r"""log of Eq. 14a, evaluated stably as :math:`\log\kappa-\log(2\pi(1-e^{-2\kappa}))+\kappa(\mu\cdot x-1)`.
+    r"""Log of Eq. 14a, evaluated stably as :math:`\log\kappa-\log(2\pi(1-e^{-2\kappa}))+\kappa(\mu\cdot x-1)`.
 
     ``x`` (..., 3) are directions (normalised here; NaN rows give NaN, zero rows are an
     error), ``mu`` a non-zero 3-vector and ``kappa`` ≥ 0 finite. κ → 0 tends to the
@@ -361,7 +363,7 @@ def vmf_logpdf(x, mu, kappa: float) -> np.ndarray:
 
 
 def vmf_pdf(x, mu, kappa: float) -> np.ndarray:
-    """vMF density (sr⁻¹), Eq. 14a.
+    """VMF density (sr⁻¹), Eq. 14a.
 
     Parameters
     ----------
@@ -614,7 +616,8 @@ def _facet_radius(mesh: SphereMesh) -> np.ndarray:
 
 def _map_mesh(tmap: xr.Dataset, mesh: SphereMesh | None) -> SphereMesh | None:
     """The mesh a tilt-map Dataset was counted on (given, or rebuilt from its
-    ``n_vertices`` attribute), or None when it cannot be known."""
+    ``n_vertices`` attribute), or None when it cannot be known.
+    """
     n_faces = tmap.sizes.get("facet")
     if mesh is None and "n_vertices" in tmap.attrs:
         try:

@@ -75,7 +75,8 @@ def session_table(features) -> pd.DataFrame:
 
 def _names(given, present: list[str], what: str) -> list[str]:
     """``given`` (a sequence of labels present in the data, in the order wanted) or
-    every label present; an unknown label is an error naming the known ones."""
+    every label present; an unknown label is an error naming the known ones.
+    """
     if given is None:
         return list(present)
     if isinstance(given, str):
@@ -94,7 +95,8 @@ def _names(given, present: list[str], what: str) -> list[str]:
 
 def _default_order(timepoints: list[str]) -> list[str]:
     """'baseline' first, then durations (1h, 2d …) in time order; labels that do not
-    read as durations keep their order of appearance."""
+    read as durations keep their order of appearance.
+    """
     rest = [t for t in timepoints if t != "baseline"]
     try:
         rest.sort(key=_timepoint_key)
@@ -142,7 +144,8 @@ class StudyDesign:
     @property
     def compared_timepoints(self) -> list[str]:
         """Time points of the between-group tests: those after the baseline, or the
-        only one."""
+        only one.
+        """
         return [t for t in self.timepoints if t != self.baseline]
 
     @property

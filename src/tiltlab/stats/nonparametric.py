@@ -317,7 +317,8 @@ def _tie_term(ranks: np.ndarray) -> float:
 
 def _beyond_exact(test: str, why: str, requested: str) -> str:
     """The note of an exact test replaced by the normal approximation (and a warning
-    when ``method="exact"`` was asked for explicitly)."""
+    when ``method="exact"`` was asked for explicitly).
+    """
     note = (
         f"exact null distribution not computed ({why}); normal approximation used "
         "instead"

@@ -327,7 +327,8 @@ def power_by_simulation(
 @dataclass(frozen=True)
 class PowerResult:
     """Animals per group needed: ``n`` (None if not reached by ``n_max``), its
-    simulated ``power`` and the ``table`` of every size evaluated."""
+    simulated ``power`` and the ``table`` of every size evaluated.
+    """
 
     n: int | None
     power: float

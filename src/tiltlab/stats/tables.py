@@ -83,7 +83,8 @@ _UNIT_HOURS = {"min": 1 / 60, "h": 1.0, "d": 24.0, "w": 168.0}
 
 def _frame(features, feature: str) -> pd.DataFrame:
     """Every session: ``session`` (None when the table has no ids), ``subject``,
-    ``group``, ``timepoint``, ``value`` and ``status`` (``"ok"`` when absent)."""
+    ``group``, ``timepoint``, ``value`` and ``status`` (``"ok"`` when absent).
+    """
     need = ("subject", "group", "timepoint")
     if isinstance(features, xr.Dataset):
         if "session" not in features.dims:

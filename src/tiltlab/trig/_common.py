@@ -89,7 +89,8 @@ def read_angles(a: xr.DataArray, name: str, *, angle: bool = True):
 
 def label_like(values, da: xr.DataArray, name: str, units: str | None, attrs=None):
     """``values`` as a DataArray labelled like ``da`` (its dims and coordinates when the
-    shapes agree, else its ``time`` coordinate), with ``fs`` (and ``method``) kept."""
+    shapes agree, else its ``time`` coordinate), with ``fs`` (and ``method``) kept.
+    """
     values = np.asarray(values)
     a: dict = {}
     for key in ("fs", "method"):

@@ -17,7 +17,8 @@ __all__ = ["Orientation", "Posture", "Arc", "Rotations", "OscillationStats"]
 
 class Posture(NamedTuple):
     """Elevation φ, bank λ (Eq. 3), overall inclination ζ and postural orientation χ
-    (Eq. 2), rad."""
+    (Eq. 2), rad.
+    """
 
     elevation: np.ndarray
     bank: np.ndarray
@@ -27,7 +28,8 @@ class Posture(NamedTuple):
 
 class Arc(NamedTuple):
     """Orthodromic arc: size ω ∈ [0, π], initial and final inclinations δ^i, δ^f
-    (rad)."""
+    (rad).
+    """
 
     size: np.ndarray
     initial: np.ndarray
@@ -36,7 +38,8 @@ class Arc(NamedTuple):
 
 class Rotations(NamedTuple):
     """Body rotations over a step: yaw α (heave axis), pitch β (sway axis, + nose up),
-    roll ρ (surge axis), rad."""
+    roll ρ (surge axis), rad.
+    """
 
     yaw: np.ndarray
     pitch: np.ndarray
@@ -45,7 +48,8 @@ class Rotations(NamedTuple):
 
 class OscillationStats(NamedTuple):
     """Per-window crossing statistics: window centre time (s), mean delay d̄ (s), CV,
-    period 2d̄ (s), number of intervals."""
+    period 2d̄ (s), number of intervals.
+    """
 
     time: np.ndarray
     mean_delay: np.ndarray

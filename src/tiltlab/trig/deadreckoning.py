@@ -123,7 +123,8 @@ def velocity_components(speed, az, el=None) -> np.ndarray:
 
 def _steps(**named) -> list[np.ndarray]:
     """Per-step inputs as finite 1-D arrays of one length; NaN/inf or a mismatch is an
-    error naming the argument (a NaN step would corrupt its whole anchor interval)."""
+    error naming the argument (a NaN step would corrupt its whole anchor interval).
+    """
     out = [_v.vectors(a, k, width=None, ndim=1) for k, a in named.items()]
     n = out[0].shape[0]
     for k, a in zip(named, out, strict=True):

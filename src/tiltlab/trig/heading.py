@@ -44,7 +44,8 @@ def _declination(declination) -> np.ndarray:
 
 def _undefined(A, M, singular_tol: float) -> np.ndarray:
     """Samples whose azimuth is undefined: zero acceleration or field, or a field
-    parallel to the acceleration (‖A×M‖ ≤ singular_tol·‖A‖‖M‖: no horizontal field)."""
+    parallel to the acceleration (‖A×M‖ ≤ singular_tol·‖A‖‖M‖: no horizontal field).
+    """
     A, M = np.broadcast_arrays(A, M)
     na = np.linalg.norm(A, axis=-1)
     nm = np.linalg.norm(M, axis=-1)
