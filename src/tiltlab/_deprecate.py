@@ -15,7 +15,7 @@ from typing import Any, TypeVar
 
 F = TypeVar("F", bound=Callable[..., Any])
 
-__all__ = ["renamed"]
+__all__ = ["alias", "renamed"]
 
 
 def renamed(**old_to_new: str) -> Callable[[F], F]:
@@ -69,3 +69,48 @@ def renamed(**old_to_new: str) -> Callable[[F], F]:
         return wrapper  # type: ignore[return-value]
 
     return decorate
+
+
+def alias(func: F, old_name: str) -> F:
+    """Keep a renamed function's old name for one release, with a ``FutureWarning``.
+
+    Parameters
+    ----------
+    func : callable
+        The function under its new name.
+    old_name : str
+        The name it had.
+
+    Returns
+    -------
+    callable
+        A wrapper that warns that ``old_name`` is now ``func.__name__``, then calls
+        ``func``; its ``__deprecated_alias_of__`` attribute is ``func``.
+
+    Examples
+    --------
+    >>> import warnings
+    >>> def load_model(path):
+    ...     return path.upper()
+    >>> load = alias(load_model, "load")
+    >>> with warnings.catch_warnings(record=True) as caught:
+    ...     warnings.simplefilter("always")
+    ...     load("w.pt")
+    'W.PT'
+    >>> str(caught[0].message)
+    'load was renamed load_model; the old name goes in the next release'
+    """
+
+    @functools.wraps(func)
+    def wrapper(*args: Any, **kwargs: Any) -> Any:
+        warnings.warn(
+            f"{old_name} was renamed {func.__name__}; the old name goes in the next "
+            "release",
+            FutureWarning,
+            stacklevel=2,
+        )
+        return func(*args, **kwargs)
+
+    wrapper.__name__ = wrapper.__qualname__ = old_name
+    wrapper.__deprecated_alias_of__ = func  # type: ignore[attr-defined]
+    return wrapper  # type: ignore[return-value]
