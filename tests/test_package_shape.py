@@ -44,3 +44,29 @@ def test_no_name_means_two_things_in_a_package():
                     clashes.append(f"{name}: {seen[name][0]} and {sub.name}")
                 seen.setdefault(name, (sub.name, obj))
     assert not clashes, f"one name, two meanings: {clashes}"
+
+
+def test_one_name_one_behaviour_across_the_package():
+    """Across the whole package, a public name exported by two modules is one object
+    (homonyms such as two ``gravity`` or two ``wrap_angle`` with different behaviour
+    are renamed or merged; a deprecated alias of a renamed function does not count)."""
+    import importlib
+    import inspect
+    import pkgutil
+
+    import tiltlab
+
+    owners: dict[str, dict[int, str]] = {}
+    for info in pkgutil.walk_packages(tiltlab.__path__, "tiltlab."):
+        if info.name.endswith("__main__"):
+            continue
+        module = importlib.import_module(info.name)
+        for name in getattr(module, "__all__", []):
+            obj = getattr(module, name, None)
+            if obj is None or getattr(obj, "__deprecated_alias_of__", None):
+                continue
+            if not (callable(obj) or name.isupper()) or inspect.ismodule(obj):
+                continue
+            owners.setdefault(name, {}).setdefault(id(obj), info.name)
+    clashes = {n: sorted(o.values()) for n, o in owners.items() if len(o) > 1}
+    assert not clashes, f"one name, two behaviours: {clashes}"
