@@ -98,7 +98,7 @@ def test_estimate_on_a_recording_equals_the_array_call(use_mag):
         assert f"param_{k}" in qr.attrs
     assert "eskf" in F.methods() and "eskf" in F.methods("causal")
     assert F.METHODS["eskf"].supports_mag
-    assert set(F.METHODS["eskf"].options) == {"q0", "b0"}
+    assert set(F.METHODS["eskf"].options) == {"q0", "gyr_offset"}
 
 
 @pytest.mark.parametrize(
@@ -113,7 +113,7 @@ def test_estimate_on_a_recording_equals_the_array_call(use_mag):
         ({"tilt_std": np.nan}, "tilt_std"),
         ({"heading_std": -1.0}, "heading_std"),
         ({"init_window_s": -1.0}, "init_window_s"),
-        ({"b0": [0.0, 0.0]}, "b0"),
+        ({"gyr_offset": [0.0, 0.0]}, "gyr_offset"),
         ({"q0": [0.0, 0.0, 0.0, 0.0]}, "q0"),
     ],
 )

@@ -82,7 +82,14 @@ def test_mahony_matches_ahrs(motion, with_mag):
         kw["mag"] = mag
     ref = ahrs_filters.Mahony(**kw).Q
     ours = F.mahony(
-        acc, gyr, fs, mag=mag if with_mag else None, kp=0.8, ki=0.2, q0=q0, b0=b0
+        acc,
+        gyr,
+        fs,
+        mag=mag if with_mag else None,
+        kp=0.8,
+        ki=0.2,
+        q0=q0,
+        gyr_offset=b0,
     )
     assert _close(ours, ref) < 1e-10
 
@@ -743,7 +750,7 @@ def test_rts_smoother_recovers_gyro_bias_and_scale_and_beats_forward_pass():
     scale = np.array([0.02, -0.015, 0.01])
     gyr = omega * (1.0 + scale) + bias
     # start from a zero bias so that the filter has to learn it (not the rest estimate)
-    kw = dict(RTS_KW, bias=np.zeros(3), bias_std=0.02, scale_std=0.03)
+    kw = dict(RTS_KW, gyr_offset=np.zeros(3), bias_std=0.02, scale_std=0.03)
     qf, xf = F.rts_smoother(acc, gyr, fs, smooth=False, return_state=True, **kw)
     qs, xs = F.rts_smoother(acc, gyr, fs, return_state=True, **kw)
     assert np.allclose(xs[:, :3], bias, atol=5e-4)  # rad/s (0.03 °/s)

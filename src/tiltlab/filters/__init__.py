@@ -1,4 +1,6 @@
-r"""Orientation filters: numba kernels, one method registry and the :func:`estimate`
+r"""Estimate orientations: numba filters, one method registry and :func:`estimate`.
+
+The orientation filters' numba kernels, one method registry and the :func:`estimate`
 wrapper (layer 5).
 
 Every filter turns a Recording's accelerometer (specific force), gyroscope and
@@ -115,7 +117,7 @@ kernels use, so ``madgwick(rec["acc"], rec["gyr"], rec.attrs["fs"])`` gives exac
 Each input is read on its own: a plain array keeps its documented unit even next to a
 labelled one. Plain arrays behave exactly as before, and the outputs are plain arrays
 in every case (:func:`estimate` labels its output). Initial states given as arguments
-(``b0``, ``bias``) and bias outputs stay in rad/s.
+(``gyr_offset``) and bias outputs stay in rad/s.
 
 Sample indexing
 ---------------
@@ -197,12 +199,20 @@ from .adapters import (
     run_vqf,
 )
 from .complementary import complementary
-from .ekf import ekf
-from .eskf import eskf
+from .ekf import EkfTuning, ekf
+from .eskf import EskfTuning, eskf
 from .lowpass import lowpass_tilt
 from .madgwick import madgwick, madgwick_batch
 from .mahony import mahony
-from .recordings import Inputs, estimate, gravity, prepare, run
+from .recordings import (
+    ESTIMATE_GAP_POLICIES,
+    Inputs,
+    estimate,
+    gravity,
+    prepare,
+    run,
+    run_method,
+)
 from .registry import (
     METHODS,
     PARAMETER_UNITS,
@@ -214,7 +224,7 @@ from .registry import (
     missing_sensor_message,
     vector_observation,
 )
-from .rts import rts_smoother
+from .rts import RtsTuning, rts_smoother
 from .smoothers import rest_gyro_bias, smoother
 from .vectors import davenport, magnetic_dip
 
@@ -231,8 +241,10 @@ __all__ = [
     "estimate",
     "gravity",
     "prepare",
+    "run_method",
     "run",
     "Inputs",
+    "ESTIMATE_GAP_POLICIES",
     "initial_orientation",
     "tilt_quaternion",
     "lowpass_tilt",
@@ -241,10 +253,13 @@ __all__ = [
     "madgwick_batch",
     "mahony",
     "ekf",
+    "EkfTuning",
     "eskf",
+    "EskfTuning",
     "smoother",
     "rest_gyro_bias",
     "rts_smoother",
+    "RtsTuning",
     "run_vqf",
     "run_offline_vqf",
     "run_imufusion",

@@ -1,5 +1,7 @@
-"""Shared pieces of the orientation filters: input checks, the initial orientation,
-the minimal tilt quaternion and ``q0`` handling.
+"""Share the orientation filters' pieces: input checks, initial orientation, options.
+
+The input checks, the initial orientation, the minimal tilt quaternion, ``q0`` and
+``gyr_offset`` handling, and the tuning records of the Kalman filters (:func:`tuned`).
 
 Every filter function reads its arrays through :func:`read_sensors` (or
 :func:`unlabel` then :func:`samples`) and its numeric parameters through
@@ -11,6 +13,11 @@ to the plain arrays in the units the kernels use.
 
 from __future__ import annotations
 
+import functools
+import inspect
+from collections.abc import Callable
+from typing import Any, TypeVar
+
 import numpy as np
 import xarray as xr
 
@@ -19,7 +26,10 @@ from .. import quaternion as quat
 from .. import units as _units
 
 __all__ = [
+    "check_tuning",
     "initial_orientation",
+    "offset_vector",
+    "tuned",
     "is_labelled",
     "read_sensors",
     "tilt_quaternion",
@@ -29,19 +39,36 @@ __all__ = [
     "unlabel",
 ]
 
+F = TypeVar("F", bound=Callable[..., Any])
+
 
 def samples(
     a, name: str, n: int | None = None, *, nonzero: bool | None = None
 ) -> np.ndarray:
-    """A contiguous float (N, 3) copy of ``a``; bad samples raise a ValueError naming
-    ``name``.
+    """Return a contiguous float (N, 3) copy of ``a``, refusing bad samples by name.
 
-    Refused: a wrong shape, no samples at all, NaN or infinite values (the filters need
+    Refused (a ValueError naming ``name``): a wrong shape, no samples at all, NaN or infinite values (the filters need
     finite samples: interpolate or split the recording, e.g. with
     ``estimate(..., gaps="segments")``), a length other than ``n`` and, with
     ``nonzero`` (default: for ``acc``), samples that are all zero (an accelerometer
     that reads exactly zero throughout has no gravity direction: a disconnected sensor
     or a zero-filled dropout).
+
+    Parameters
+    ----------
+    a : array_like, shape (N, 3)
+        The samples.
+    name : str
+        The input's name, for the messages.
+    n : int, optional
+        The number of samples required.
+    nonzero : bool, optional
+        Refuse samples that are all zero (default: for ``acc`` only).
+
+    Returns
+    -------
+    numpy.ndarray, shape (N, 3)
+        A contiguous float64 copy.
     """
     x = _v.vectors(a, name, width=3, ndim=2, allow_nan=True)
     if x.shape[0] == 0:
@@ -71,7 +98,7 @@ MAX_GYR_RAD_S = 1.0e4
 
 
 def sensor_inputs(acc, gyr, mag=None):
-    """``(acc, gyr, mag_or_dummy, use_mag)`` as contiguous (N, 3) arrays for the kernels.
+    """Return ``(acc, gyr, mag_or_dummy, use_mag)`` as contiguous arrays for the kernels.
 
     Plain arrays (labelled ones are read first by :func:`unlabel`: see
     :func:`read_sensors`). Every filter and adapter reads its arrays here (or through
@@ -80,6 +107,18 @@ def sensor_inputs(acc, gyr, mag=None):
     sample, and angular rates above :data:`MAX_GYR_RAD_S`.
     Without a magnetometer, a (1, 3) zero array stands in for ``mag`` (the kernels take
     an array in every case) and ``use_mag`` is False.
+
+    Parameters
+    ----------
+    acc, gyr : array_like, shape (N, 3)
+        Accelerometer and gyroscope samples (plain arrays; ``gyr`` in rad/s).
+    mag : array_like, shape (N, 3), optional
+        Magnetometer samples.
+
+    Returns
+    -------
+    tuple
+        ``(acc, gyr, mag_or_dummy, use_mag)``: three float64 arrays and a bool.
     """
     acc = samples(acc, "acc", nonzero=True)
     gyr = samples(gyr, "gyr", acc.shape[0])
@@ -95,26 +134,74 @@ def sensor_inputs(acc, gyr, mag=None):
 
 
 def read_sensors(fs, acc, gyr, mag=None, *, acc_si: bool = False):
-    """``(fs, acc, gyr, mag_or_dummy, use_mag)`` for the kernels, labels honoured.
+    """Return ``(fs, acc, gyr, mag_or_dummy, use_mag)`` for the kernels, labels honoured.
 
     :func:`unlabel` (labelled inputs: units converted to m/s² and rad/s, ``fs`` read
     and cross-checked) followed by :func:`sensor_inputs` (shape, finiteness, length
     and range checks). Plain arrays give exactly what ``check_fs`` and
     :func:`sensor_inputs` gave before labels were read.
+
+    Parameters
+    ----------
+    fs : float or None
+        Sampling rate (Hz); may be None for labelled inputs with ``attrs["fs"]``.
+    acc, gyr : array_like or xarray.DataArray, shape (N, 3)
+        Accelerometer and gyroscope samples.
+    mag : array_like or xarray.DataArray, shape (N, 3), optional
+        Magnetometer samples.
+    acc_si : bool
+        The method uses ``acc`` in m/s² (a labelled ``acc`` needs ``units``).
+
+    Returns
+    -------
+    tuple
+        ``(fs, acc, gyr, mag_or_dummy, use_mag)``, as :func:`sensor_inputs` with the
+        sampling rate first.
     """
     fs, acc, gyr, mag = unlabel(fs, acc=acc, gyr=gyr, mag=mag, acc_si=acc_si)
     return (fs, *sensor_inputs(acc, gyr, mag))
 
 
 def init_samples(init_window_s: float, fs: float) -> int:
-    """Number of samples (at least 1) in the initialisation window of ``init_window_s``."""
+    """Count the samples (at least 1) in an initialisation window.
+
+    Parameters
+    ----------
+    init_window_s : float
+        The window (s), ``>= 0``.
+    fs : float
+        Sampling rate (Hz).
+
+    Returns
+    -------
+    int
+        ``max(1, round(init_window_s * fs))``.
+    """
     init_window_s = _v.nonnegative(init_window_s, "init_window_s")
     return max(1, int(round(init_window_s * fs)))
 
 
 def start_orientation(q0, acc, mag, fs: float, init_window_s: float) -> np.ndarray:
-    """The initial orientation: ``q0`` normalised, or :func:`initial_orientation` of the
-    first ``init_window_s`` seconds of ``acc`` (and ``mag``).
+    """Return the initial orientation: ``q0`` normalised, or one from the first samples.
+
+    Parameters
+    ----------
+    q0 : array_like, shape (4,) or None
+        A given initial orientation (any non-zero norm).
+    acc : numpy.ndarray, shape (N, 3)
+        Accelerometer samples.
+    mag : numpy.ndarray, shape (N, 3) or None
+        Magnetometer samples (9D).
+    fs : float
+        Sampling rate (Hz).
+    init_window_s : float
+        Without ``q0``: :func:`initial_orientation` of the first ``init_window_s``
+        seconds of ``acc`` (and ``mag``).
+
+    Returns
+    -------
+    numpy.ndarray, shape (4,)
+        Unit quaternion, sensor → world.
     """
     n = init_samples(init_window_s, fs)
     if q0 is None:
@@ -128,8 +215,17 @@ def start_orientation(q0, acc, mag, fs: float, init_window_s: float) -> np.ndarr
 
 
 def tilt_quaternion(g) -> np.ndarray:
-    """Minimal rotations (zero heading part) taking unit vectors ``g`` (sensor) to e_z
-    (world); ``g = -e_z`` gives the half turn about x.
+    """Return the minimal rotations (zero heading part) taking unit ``g`` to e_z.
+
+    Parameters
+    ----------
+    g : array_like, shape (..., 3)
+        Unit vectors (sensor frame); ``g = -e_z`` gives the half turn about x.
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., 4)
+        Unit quaternions sensor → world with ``R(q) g = e_z``.
     """
     g = np.asarray(g, float)
     q = np.stack(
@@ -202,7 +298,18 @@ _PLAIN_UNIT = {"acc": "m/s²", "gyr": "rad/s", "mag": "any unit"}
 
 
 def is_labelled(a) -> bool:
-    """Whether ``a`` carries labels (an :class:`xarray.DataArray` or a Recording)."""
+    """Tell whether ``a`` carries labels (an :class:`xarray.DataArray` or a Recording).
+
+    Parameters
+    ----------
+    a : object
+        An input.
+
+    Returns
+    -------
+    bool
+        True for a DataArray or a Dataset.
+    """
     return isinstance(a, (xr.DataArray, xr.Dataset))
 
 
@@ -260,9 +367,9 @@ def _read_labelled(a, name: str, fs: float | None, acc_si: bool) -> _v.Signal:
 
 
 def _time_agrees(a, name: str, fs: float) -> None:
-    """Refuse an ``fs`` argument that contradicts the ``time`` coordinate of a labelled
-    input without an ``fs`` attribute (as :func:`tiltlab._validate.signal` does for the
-    attribute).
+    """Refuse an ``fs`` contradicting the ``time`` of a labelled input without ``fs``.
+
+    As :func:`tiltlab._validate.signal` does for the attribute.
     """
     da = a[name] if isinstance(a, xr.Dataset) and name in a else a
     if not isinstance(da, xr.DataArray) or "time" not in da.coords:
@@ -281,7 +388,7 @@ def _time_agrees(a, name: str, fs: float) -> None:
 
 
 def _same_rate(rates: dict[str, float]) -> float | None:
-    """The one sampling rate of ``rates`` (by input name); disagreeing ones are refused."""
+    """Return the one sampling rate of ``rates`` (by input name); refuse disagreements."""
     if not rates:
         return None
     (first, f0), *rest = rates.items()
@@ -357,6 +464,25 @@ def unlabel(
     documented unit. ``need_fs=False`` (functions without a sampling rate) returns the
     rate found, or ``None``. The conversion is one vectorised multiplication per input,
     before any kernel runs.
+
+    Parameters
+    ----------
+    fs : float or None
+        The sampling rate argument (Hz).
+    acc : array_like, xarray.DataArray or xarray.Dataset
+        Accelerometer samples (a Recording: its ``acc`` variable).
+    gyr, mag : array_like, xarray.DataArray or xarray.Dataset, optional
+        Gyroscope and magnetometer samples.
+    acc_si : bool
+        The method uses ``acc`` in m/s².
+    need_fs : bool
+        Refuse an unknown sampling rate.
+
+    Returns
+    -------
+    tuple
+        ``(fs, acc, gyr, mag)``: the rate and the inputs as plain arrays (plain inputs
+        unchanged, ``None`` where not given).
     """
     given = {"acc": acc, "gyr": gyr, "mag": mag}
     labelled = {n: a for n, a in given.items() if a is not None and is_labelled(a)}
@@ -389,3 +515,112 @@ def unlabel(
     _same_time(signals, f)
     out = {n: (signals[n].values if n in signals else a) for n, a in given.items()}
     return f, out["acc"], out["gyr"], out["mag"]
+
+
+# --------------------------------------------------------------------------- options
+
+
+def offset_vector(gyr_offset, default=None) -> np.ndarray:
+    """Read a gyroscope offset (bias) argument as a contiguous float (3,) array.
+
+    Parameters
+    ----------
+    gyr_offset : array_like, shape (3,), optional
+        The offset (rad/s); any shape with 3 values is flattened.
+    default : numpy.ndarray, shape (3,), optional
+        Returned when ``gyr_offset`` is None (default: zeros).
+
+    Returns
+    -------
+    numpy.ndarray, shape (3,)
+        The offset; a finite value is required (ValueError naming ``gyr_offset``).
+    """
+    if gyr_offset is None:
+        return np.zeros(3) if default is None else default
+    flat = np.reshape(np.asarray(gyr_offset, float), -1)
+    return np.ascontiguousarray(_v.vectors(flat, "gyr_offset", width=3, ndim=1))
+
+
+def tuned(record: type) -> Callable[[F], F]:
+    """Give a filter the fields of a tuning record as keyword options.
+
+    The decorated function takes a keyword-only ``tuning`` argument (an instance of
+    ``record``, a :class:`typing.NamedTuple` whose field defaults are the filter's
+    defaults: the one place they are written). The returned function takes instead
+    one keyword per field, builds the record from them (the others keep their
+    defaults) and passes it on. Its signature (:func:`inspect.signature`, ``help``,
+    :attr:`tiltlab.filters.Method.defaults`) lists the fields in place of ``tuning``,
+    and its ``tuning`` attribute is ``record``.
+
+    Parameters
+    ----------
+    record : type
+        A :class:`typing.NamedTuple` with a default for every field.
+
+    Returns
+    -------
+    callable
+        The decorator.
+    """
+    fields = tuple(record._fields)
+
+    def decorate(func: F) -> F:
+        @functools.wraps(func)
+        def wrapper(*args: Any, **kwargs: Any) -> Any:
+            values = {k: kwargs.pop(k) for k in fields if k in kwargs}
+            if "tuning" in kwargs:
+                raise TypeError(
+                    f"{func.__name__}() got an unexpected keyword argument 'tuning'"
+                )
+            return func(*args, tuning=record(**values), **kwargs)
+
+        sig = inspect.signature(func)
+        hints = {
+            k: getattr(v, "__forward_arg__", v)  # "float", as the other annotations
+            for k, v in record.__annotations__.items()
+        }
+        params = []
+        for p in sig.parameters.values():
+            if p.name != "tuning":
+                params.append(p)
+                continue
+            params += [
+                inspect.Parameter(
+                    k,
+                    inspect.Parameter.KEYWORD_ONLY,
+                    default=record._field_defaults[k],
+                    annotation=hints.get(k, inspect.Parameter.empty),
+                )
+                for k in fields
+            ]
+        wrapper.__signature__ = sig.replace(parameters=params)  # type: ignore[attr-defined]
+        wrapper.tuning = record  # type: ignore[attr-defined]
+        return wrapper  # type: ignore[return-value]
+
+    return decorate
+
+
+def check_tuning(tuning, *, positive: tuple[str, ...] = (), inf: tuple[str, ...] = ()):
+    """Validate every field of a tuning record as a number ``>= 0``.
+
+    Parameters
+    ----------
+    tuning : typing.NamedTuple
+        A filter's tuning record (see :func:`tuned`).
+    positive : tuple of str
+        Fields that must be ``> 0`` (the others may be zero).
+    inf : tuple of str
+        Fields that may be infinite (the others must be finite).
+
+    Returns
+    -------
+    typing.NamedTuple
+        The record with every field as a float; a bad value is a ValueError naming
+        its field.
+    """
+    return tuning._replace(
+        **{
+            k: _v.positive(v, k, allow_zero=k not in positive, allow_inf=k in inf)
+            for k, v in tuning._asdict().items()
+        }
+    )

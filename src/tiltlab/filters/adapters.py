@@ -1,5 +1,6 @@
-"""Adapters to reference implementations, for comparison: ``vqf`` (VQF and offlineVQF,
-Laidig & Seel 2023), ``imufusion`` (x-io Fusion AHRS), the pure-Python ``ahrs``
+"""Adapt reference implementations for comparison: ``vqf``, ``imufusion``, ``ahrs``, ``riann``.
+
+``vqf`` (VQF and offlineVQF, Laidig & Seel 2023), ``imufusion`` (x-io Fusion AHRS), the pure-Python ``ahrs``
 package (Madgwick, Mahony, EKF) and ``riann`` (RIANN, the published recurrent network of
 Weber, Gühmann & Seel 2021).
 
@@ -24,6 +25,7 @@ from ._common import (
     sensor_inputs,
     unlabel,
 )
+from ._docs import shared_docs
 
 __all__ = [
     "vqf_parameter_names",
@@ -38,7 +40,13 @@ __all__ = [
 
 
 def vqf_parameter_names() -> frozenset[str]:
-    """Names of the ``vqf`` package's own parameters (``tauAcc``, ``restThGyr``, …)."""
+    """List the ``vqf`` package's own parameters (``tauAcc``, ``restThGyr``, …).
+
+    Returns
+    -------
+    frozenset of str
+        The parameter names of ``vqf.VQF``.
+    """
     import vqf
 
     return frozenset(vqf.VQF(0.01).params)
@@ -62,64 +70,54 @@ def _vqf(acc, gyr, fs, mag, offline: bool, params: dict) -> np.ndarray:
     return np.asarray(res["quat9D" if use_mag else "quat6D"])
 
 
+@shared_docs
 def run_vqf(acc, gyr, fs: float | None = None, *, mag=None, **vqf_params) -> np.ndarray:
-    """VQF (``vqf.VQF(...).updateBatch``), 6D or 9D; ``vqf_params`` are the ``vqf``
-    package's own parameters with its own defaults (e.g. ``tauAcc`` in s).
+    """Run VQF (``vqf.VQF(...).updateBatch``), 6D or 9D.
+
+    ``vqf_params`` are the ``vqf`` package's own parameters with its own defaults (e.g.
+    ``tauAcc`` in s).
 
     Parameters
     ----------
-    acc : array_like or xarray.DataArray, shape (N, 3)
-        Specific force, m/s² (a labelled DataArray: converted from its ``units``).
-    gyr : array_like or xarray.DataArray, shape (N, 3)
-        Angular rate, rad/s (a labelled DataArray: converted from its ``units``).
-    fs : float, optional
-        Sampling rate, Hz (mandatory for plain arrays; labelled inputs may carry it
-        as ``attrs["fs"]``).
-    mag : array_like or xarray.DataArray, shape (N, 3), optional
-        Magnetic field (any consistent unit); given, the 9D filter runs, else 6D.
+    %(si_inputs)s
+    %(vqf_mag)s
     **vqf_params
         Parameters of ``vqf.VQF`` (e.g. ``tauAcc`` in s); an unknown name is a
         ValueError.
 
     Returns
     -------
-    numpy.ndarray, shape (N, 4)
-        Unit quaternions (w, x, y, z) sensor → world, world z up (heading arbitrary
-        in 6D).
+    %(q_6d_9d)s
     """
     return _vqf(acc, gyr, fs, mag, False, vqf_params)
 
 
+@shared_docs
 def run_offline_vqf(
     acc, gyr, fs: float | None = None, *, mag=None, **vqf_params
 ) -> np.ndarray:
-    """OfflineVQF (``vqf.offlineVQF``, non-causal), 6D or 9D; ``vqf_params`` as for
-    :func:`run_vqf`.
+    """Run offlineVQF (``vqf.offlineVQF``, non-causal), 6D or 9D.
+
+    The same inputs and outputs as :func:`run_vqf`; the estimate uses past and future
+    samples.
 
     Parameters
     ----------
-    acc : array_like or xarray.DataArray, shape (N, 3)
-        Specific force, m/s² (a labelled DataArray: converted from its ``units``).
-    gyr : array_like or xarray.DataArray, shape (N, 3)
-        Angular rate, rad/s (a labelled DataArray: converted from its ``units``).
-    fs : float, optional
-        Sampling rate, Hz (mandatory for plain arrays; labelled inputs may carry it
-        as ``attrs["fs"]``).
-    mag : array_like or xarray.DataArray, shape (N, 3), optional
-        Magnetic field (any consistent unit); given, the 9D filter runs, else 6D.
+    acc, gyr, fs, mag
+        As for :func:`run_vqf`.
     **vqf_params
-        Parameters of ``vqf.offlineVQF`` (e.g. ``tauAcc`` in s); an unknown name is a
-        ValueError.
+        Parameters of ``vqf.offlineVQF`` (its ``tauAcc``, ``restThGyr``, …, the names
+        of :func:`vqf_parameter_names`); an unknown name is a ValueError.
 
     Returns
     -------
     numpy.ndarray, shape (N, 4)
-        Unit quaternions (w, x, y, z) sensor → world, world z up (heading arbitrary
-        in 6D).
+        As for :func:`run_vqf`.
     """
     return _vqf(acc, gyr, fs, mag, True, vqf_params)
 
 
+@shared_docs
 def run_imufusion(
     acc,
     gyr,
@@ -137,13 +135,7 @@ def run_imufusion(
 
     Parameters
     ----------
-    acc : array_like or xarray.DataArray, shape (N, 3)
-        Specific force, m/s² (a labelled DataArray: converted from its ``units``).
-    gyr : array_like or xarray.DataArray, shape (N, 3)
-        Angular rate, rad/s (a labelled DataArray: converted from its ``units``).
-    fs : float, optional
-        Sampling rate, Hz (mandatory for plain arrays; labelled inputs may carry it
-        as ``attrs["fs"]``).
+    %(si_inputs)s
     gain : float
         Fusion's gain (≥ 0; 0 integrates the gyroscope alone).
     acceleration_rejection_deg : float
@@ -153,8 +145,7 @@ def run_imufusion(
 
     Returns
     -------
-    numpy.ndarray, shape (N, 4)
-        Unit quaternions (w, x, y, z) sensor → world, world z up, heading arbitrary.
+    %(q_z_up)s
     """
     import imufusion
 
@@ -189,31 +180,24 @@ def _ahrs_start(acc, gyr, fs, init_window_s):
     return acc, gyr, fs, q0
 
 
+@shared_docs
 def run_ahrs_madgwick(
     acc, gyr, fs: float | None = None, *, beta: float = 0.05, init_window_s: float = 0.1
 ) -> np.ndarray:
-    """``ahrs.filters.Madgwick`` (6D) with an explicit ``frequency``, started at
-    :func:`initial_orientation` of the first ``init_window_s`` seconds.
+    """Run ``ahrs.filters.Madgwick`` (6D) with an explicit ``frequency``.
+
+    Started at :func:`initial_orientation` of the first ``init_window_s`` seconds.
 
     Parameters
     ----------
-    acc : array_like or xarray.DataArray, shape (N, 3)
-        Specific force, m/s² (a labelled DataArray: converted from its ``units``).
-    gyr : array_like or xarray.DataArray, shape (N, 3)
-        Angular rate, rad/s (a labelled DataArray: converted from its ``units``).
-    fs : float, optional
-        Sampling rate, Hz (mandatory for plain arrays; labelled inputs may carry it
-        as ``attrs["fs"]``).
+    %(si_inputs)s
     beta : float
         Madgwick's gain β (≥ 0, rad/s).
-    init_window_s : float
-        Duration (s) of the start of the record whose mean orientation starts the
-        filter.
+    %(ahrs_init)s
 
     Returns
     -------
-    numpy.ndarray, shape (N, 4)
-        Unit quaternions (w, x, y, z) sensor → world, world z up, heading arbitrary.
+    %(q_z_up)s
     """
     import ahrs.filters as af
 
@@ -223,6 +207,7 @@ def run_ahrs_madgwick(
     return np.asarray(f.Q, float)
 
 
+@shared_docs
 def run_ahrs_mahony(
     acc,
     gyr,
@@ -239,25 +224,16 @@ def run_ahrs_mahony(
 
     Parameters
     ----------
-    acc : array_like or xarray.DataArray, shape (N, 3)
-        Specific force, m/s² (a labelled DataArray: converted from its ``units``).
-    gyr : array_like or xarray.DataArray, shape (N, 3)
-        Angular rate, rad/s (a labelled DataArray: converted from its ``units``).
-    fs : float, optional
-        Sampling rate, Hz (mandatory for plain arrays; labelled inputs may carry it
-        as ``attrs["fs"]``).
+    %(si_inputs)s
     kp : float
         Proportional gain k_P (≥ 0).
     ki : float
         Integral gain k_I (≥ 0; 1/s).
-    init_window_s : float
-        Duration (s) of the start of the record whose mean orientation starts the
-        filter.
+    %(ahrs_init)s
 
     Returns
     -------
-    numpy.ndarray, shape (N, 4)
-        Unit quaternions (w, x, y, z) sensor → world, world z up, heading arbitrary.
+    %(q_z_up)s
     """
     import ahrs.filters as af
 
@@ -268,6 +244,7 @@ def run_ahrs_mahony(
     return np.asarray(f.Q, float)
 
 
+@shared_docs
 def run_ahrs_ekf(
     acc,
     gyr,
@@ -277,30 +254,22 @@ def run_ahrs_ekf(
     var_acc: float = 0.5**2,
     init_window_s: float = 0.1,
 ) -> np.ndarray:
-    """``ahrs.filters.EKF`` (6D) with ``frame='NED'`` (really z up: ``ahrs``'s
-    ``frame='ENU'`` is upside down), started as :func:`run_ahrs_madgwick`.
+    """Run ``ahrs.filters.EKF`` (6D) with ``frame='NED'``, started as :func:`run_ahrs_madgwick`.
+
+    ``frame='NED'`` is really z up: ``ahrs``'s ``frame='ENU'`` is upside down.
 
     Parameters
     ----------
-    acc : array_like or xarray.DataArray, shape (N, 3)
-        Specific force, m/s² (a labelled DataArray: converted from its ``units``).
-    gyr : array_like or xarray.DataArray, shape (N, 3)
-        Angular rate, rad/s (a labelled DataArray: converted from its ``units``).
-    fs : float, optional
-        Sampling rate, Hz (mandatory for plain arrays; labelled inputs may carry it
-        as ``attrs["fs"]``).
+    %(si_inputs)s
     var_gyr : float
         Gyroscope noise variance ((rad/s)², ≥ 0).
     var_acc : float
         Accelerometer noise variance ((m/s²)², > 0).
-    init_window_s : float
-        Duration (s) of the start of the record whose mean orientation starts the
-        filter.
+    %(ahrs_init)s
 
     Returns
     -------
-    numpy.ndarray, shape (N, 4)
-        Unit quaternions (w, x, y, z) sensor → world, world z up, heading arbitrary.
+    %(q_z_up)s
     """
     import ahrs.filters as af
 
@@ -318,19 +287,15 @@ def run_ahrs_ekf(
 RIANN_CHUNK = 50_000
 
 
+@shared_docs
 def run_riann(acc, gyr, fs: float | None = None, *, mag=None) -> np.ndarray:
-    """RIANN, a published recurrent network for attitude estimation (``riann``), 6D.
+    """Run RIANN, a published recurrent network for attitude estimation (``riann``), 6D.
+
+    The network takes the sampling interval as an input, so any rate is accepted.
 
     Parameters
     ----------
-    acc : array_like or xarray.DataArray, shape (N, 3)
-        Specific force, m/s² (a labelled DataArray: converted from its ``units``).
-    gyr : array_like or xarray.DataArray, shape (N, 3)
-        Angular rate, rad/s (a labelled DataArray: converted from its ``units``).
-    fs : float, optional
-        Sampling rate, Hz (mandatory for plain arrays; labelled inputs may carry it
-        as ``attrs["fs"]``; the network takes the sampling interval as an input, so
-        any rate is accepted).
+    %(si_inputs)s
     mag : None
         Present for the adapters' uniform signature only: RIANN is a 6D method, and any
         ``mag`` other than None is a ValueError.

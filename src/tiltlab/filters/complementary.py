@@ -8,6 +8,7 @@ from numba import njit
 from .. import _validate as _v
 from ..quaternion import qmul_scalar, rotate_scalar, zoh_step_scalar
 from ._common import read_sensors, start_orientation
+from ._docs import shared_docs
 
 __all__ = ["complementary"]
 
@@ -48,6 +49,7 @@ def _complementary_kernel(acc, gyr, mag, use_mag, dt, k_acc, k_mag, q0, out):
         out[k, 0], out[k, 1], out[k, 2], out[k, 3] = w, x, y, z
 
 
+@shared_docs
 def complementary(
     acc,
     gyr,
@@ -72,25 +74,13 @@ def complementary(
 
     Parameters
     ----------
-    acc, gyr : array_like or xarray.DataArray, shape (N, 3)
-        Specific force (any unit) and angular velocity (rad/s).
-        Labelled inputs (:class:`xarray.DataArray`) are read by their attributes:
-        ``gyr`` is converted from its ``units`` (required) to rad/s, ``acc`` with
-        ``units`` to m/s² (see :mod:`tiltlab.filters`, "Labelled inputs").
-    fs : float, optional
-        Sampling rate (Hz): mandatory for plain arrays; with labelled inputs it may
-        be omitted when they carry ``attrs["fs"]``, and must agree with it when given.
-    mag : array_like or xarray.DataArray, shape (N, 3), optional
-        Magnetometer (any unit; a ``units`` attribute must be a magnetic-field unit):
-        9D, ENU world frame.
+    %(acc_gyr)s
+    %(fs)s
+    %(mag)s
     tau_acc_s, tau_mag_s : float
         Time constants (s) of the accelerometer and magnetometer corrections; ``inf``
         disables a correction.
-    q0 : array_like, shape (4,), optional
-        Initial orientation; default :func:`initial_orientation` over
-        ``init_window_s`` seconds.
-    init_window_s : float
-        Initialisation window (s).
+    %(q0_init)s
 
     Returns
     -------

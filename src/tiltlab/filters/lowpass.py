@@ -6,10 +6,12 @@ import numpy as np
 
 from .. import dsp
 from ._common import samples, tilt_quaternion, unlabel
+from ._docs import shared_docs
 
 __all__ = ["lowpass_tilt"]
 
 
+@shared_docs
 def lowpass_tilt(
     acc, fs: float | None = None, *, cutoff_hz: float = 1.0, order: int = 2
 ) -> np.ndarray:
@@ -26,9 +28,7 @@ def lowpass_tilt(
         Specific force (any unit). A labelled DataArray is read by its attributes
         (``units``: converted to m/s² when present; ``fs``; see
         :mod:`tiltlab.filters`, "Labelled inputs").
-    fs : float, optional
-        Sampling rate (Hz): mandatory for plain arrays; with labelled inputs it may
-        be omitted when they carry ``attrs["fs"]``, and must agree with it when given.
+    %(fs)s
     cutoff_hz : float
         Cut-off frequency (Hz), ``0 < cutoff_hz < fs/2``.
     order : int

@@ -15,6 +15,8 @@ from numba import njit, prange
 from .. import _validate as _v
 from ..quaternion import qmul_scalar, rotate_scalar
 from ._common import read_sensors, start_orientation
+from ._shared_kernel import _unit_sample
+from ._docs import shared_docs
 
 __all__ = ["madgwick", "madgwick_batch"]
 
@@ -34,10 +36,8 @@ def _madgwick_kernel(acc, gyr, mag, use_mag, dt, beta, q0, out):
         # qdot = 1/2 q ⊗ (0, ω)
         dw, dx, dy, dz = qmul_scalar(w, x, y, z, 0.0, gyr[k, 0], gyr[k, 1], gyr[k, 2])
         dw, dx, dy, dz = 0.5 * dw, 0.5 * dx, 0.5 * dy, 0.5 * dz
-        ax, ay, az = acc[k, 0], acc[k, 1], acc[k, 2]
-        an = np.sqrt(ax * ax + ay * ay + az * az)
+        ax, ay, az, an = _unit_sample(acc, k)
         if an > 0.0:
-            ax, ay, az = ax / an, ay / an, az / an
             # objective f = R(q)^T d - s and Jacobian J (Madgwick 2010 eqs. 25-26, 31-32)
             f1 = 2.0 * (x * z - w * y) - ax
             f2 = 2.0 * (w * x + y * z) - ay
@@ -46,13 +46,10 @@ def _madgwick_kernel(acc, gyr, mag, use_mag, dt, beta, q0, out):
             s1 = 2.0 * z * f1 + 2.0 * w * f2 - 4.0 * x * f3
             s2 = -2.0 * w * f1 + 2.0 * z * f2 - 4.0 * y * f3
             s3 = 2.0 * x * f1 + 2.0 * y * f2
-            mx, my, mz = 0.0, 0.0, 0.0
-            mn = 0.0
+            mx, my, mz, mn = 0.0, 0.0, 0.0, 0.0
             if use_mag:
-                mx, my, mz = mag[k, 0], mag[k, 1], mag[k, 2]
-                mn = np.sqrt(mx * mx + my * my + mz * mz)
+                mx, my, mz, mn = _unit_sample(mag, k)
             if mn > 0.0:
-                mx, my, mz = mx / mn, my / mn, mz / mn
                 # h = R(q) m (earth frame), reference b = (|h_xy|, 0, h_z)
                 hx, hy, hz = rotate_scalar(w, x, y, z, mx, my, mz)
                 bx = np.sqrt(hx * hx + hy * hy)
@@ -103,6 +100,24 @@ def _madgwick_batch_kernel(acc, gyr, mag, use_mag, dt, betas, q0, out):
         _madgwick_kernel(acc, gyr, mag, use_mag, dt, betas[p], q0, out[p])
 
 
+#: largest gradient step per sample, beta/fs (rad): below 1 the update cannot cancel
+#: the quaternion (its gyroscope part is orthogonal to q), and 0.5 keeps its norm ≥ 0.5
+MAX_STEP_RAD = 0.5
+
+
+def _gradient_step(beta, fs: float, name: str) -> float:
+    """Check a gain ``beta`` (rad/s): ``>= 0`` and ``beta/fs <= MAX_STEP_RAD``."""
+    beta = _v.nonnegative(beta, name)
+    if beta / fs > MAX_STEP_RAD:
+        raise ValueError(
+            f"{name} = {beta:g} rad/s is too large for fs = {fs:g} Hz: the gradient "
+            f"step per sample ({name}/fs = {beta / fs:.3g} rad) must stay at most "
+            f"{MAX_STEP_RAD:g} rad, or the update can cancel the quaternion"
+        )
+    return beta
+
+
+@shared_docs
 def madgwick(
     acc,
     gyr,
@@ -133,29 +148,35 @@ def madgwick(
     ----------
     acc, gyr : array_like or xarray.DataArray, shape (N, 3)
         Specific force (any unit, normalised per sample) and angular velocity (rad/s).
-        Labelled inputs (:class:`xarray.DataArray`) are read by their attributes:
-        ``gyr`` is converted from its ``units`` (required) to rad/s, ``acc`` with
-        ``units`` to m/s² (see :mod:`tiltlab.filters`, "Labelled inputs").
-    fs : float, optional
-        Sampling rate (Hz): mandatory for plain arrays; with labelled inputs it may
-        be omitted when they carry ``attrs["fs"]``, and must agree with it when given.
-    mag : array_like or xarray.DataArray, shape (N, 3), optional
-        Magnetometer (any unit; a ``units`` attribute must be a magnetic-field unit):
-        9D, ENU world frame.
+        %(labelled)s
+    %(fs)s
+    %(mag)s
     beta : float
-        Gradient step (rad/s), ``>= 0``.
-    q0 : array_like, shape (4,), optional
-        Initial orientation; default :func:`initial_orientation` over
-        ``init_window_s`` seconds.
-    init_window_s : float
-        Initialisation window (s).
+        Gradient step (rad/s), ``>= 0`` and at most ``0.5 * fs`` (a larger step per
+        sample can cancel the quaternion).
+    %(q0_init)s
 
     Returns
     -------
-    numpy.ndarray, shape (N, 4)
+    %(q_out)s
+
+    Examples
+    --------
+    A sensor lying still, tilted 30° about x, gyroscope reading zero: the filter
+    keeps the tilt of the initial orientation (heading zero).
+
+    >>> import numpy as np
+    >>> from tiltlab import filters, quaternion
+    >>> up = [0.0, np.sin(np.radians(30.0)), np.cos(np.radians(30.0))]
+    >>> acc = np.tile(np.multiply(up, 9.81), (200, 1))
+    >>> q = filters.madgwick(acc, np.zeros((200, 3)), 100.0, beta=0.1)
+    >>> q.shape
+    (200, 4)
+    >>> np.round(quaternion.gravity(q[-1]), 3)
+    array([0.   , 0.5  , 0.866])
     """
     fs, acc, gyr, m, use_mag = read_sensors(fs, acc, gyr, mag)
-    beta = _v.nonnegative(beta, "beta")
+    beta = _gradient_step(beta, fs, "beta")
     q0 = start_orientation(q0, acc, m if use_mag else None, fs, init_window_s)
     out = np.empty((acc.shape[0], 4))
     _madgwick_kernel(acc, gyr, m, use_mag, 1.0 / fs, beta, q0, out)
@@ -179,7 +200,7 @@ def madgwick_batch(
     acc, gyr, fs, mag, q0, init_window_s
         As for :func:`madgwick`.
     betas : array_like, shape (P,)
-        Gradient steps (rad/s), each ``>= 0``.
+        Gradient steps (rad/s), each ``>= 0`` and at most ``0.5 * fs``.
 
     Returns
     -------
@@ -189,7 +210,7 @@ def madgwick_batch(
     fs, acc, gyr, m, use_mag = read_sensors(fs, acc, gyr, mag)
     b = _v.vectors(np.atleast_1d(betas), "betas", width=None, ndim=1)
     for j, v in enumerate(b):
-        _v.nonnegative(v, f"betas[{j}]")
+        _gradient_step(v, fs, f"betas[{j}]")
     q0 = start_orientation(q0, acc, m if use_mag else None, fs, init_window_s)
     out = np.empty((b.shape[0], acc.shape[0], 4))
     _madgwick_batch_kernel(

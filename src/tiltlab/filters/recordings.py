@@ -1,11 +1,12 @@
-r"""Recording-level entry points: :func:`estimate` (a labelled ``q``) and :func:`gravity`.
+r"""Recording-level entry points: :func:`estimate` (a labelled ``q``); :func:`gravity` is :func:`tiltlab.quaternion.gravity`.
 
 :func:`prepare` reads a Recording once (through :func:`tiltlab._validate.signal`: ``fs``
 from the attrs and checked against the ``time`` axis, units from the attrs, converted to
-SI for the kernels) and :func:`run` runs a registered method on it; :func:`estimate` is
-the two together plus the labelling. Parameter searches
+SI for the kernels) and :func:`run_method` runs a registered method on it;
+:func:`estimate` is the two together plus the labelling. Parameter searches
 (:func:`tiltlab.evaluate.grid_search`) call :func:`prepare` once per Recording and
-:func:`run` once per parameter set.
+:func:`run_method` once per parameter set. (``run`` is the former name of
+:func:`run_method`, kept for one release with a FutureWarning.)
 """
 
 from __future__ import annotations
@@ -18,11 +19,20 @@ import numpy as np
 import xarray as xr
 
 from .. import _validate as _v
-from .. import quaternion as quat
+from ..quaternion import gravity  # one function, labelled or plain (re-exported)
+from .._deprecate import alias, renamed
 import tiltlab.filters.registry as registry
 from .registry import get_method
 
-__all__ = ["Inputs", "prepare", "run", "estimate", "gravity"]
+__all__ = [
+    "ESTIMATE_GAP_POLICIES",
+    "Inputs",
+    "prepare",
+    "run_method",
+    "run",
+    "estimate",
+    "gravity",
+]
 
 
 @dataclass(frozen=True)
@@ -43,6 +53,7 @@ class Inputs:
 
     @property
     def use_mag(self) -> bool:
+        """Whether a magnetometer was read (9D)."""
         return self.mag is not None
 
     @property
@@ -55,23 +66,29 @@ class Inputs:
         )
 
 
+@renamed(recording="rec")
 def prepare(
-    recording: xr.Dataset, *, use_mag: bool = False, allow_nan: bool = False
+    rec: xr.Dataset, *, use_mag: bool = False, allow_nan: bool = False
 ) -> Inputs:
     """Read a Recording's ``acc``, ``gyr`` when it has one (and ``mag``) in SI units.
 
     Parameters
     ----------
-    recording : xarray.Dataset
-        A tiltlab Recording: ``acc`` (time, axis) with a ``units`` attr, optional
+    rec : xarray.Dataset
+        A tiltlab Recording (formerly ``recording``): ``acc`` (time, axis) with a ``units`` attr, optional
         ``gyr`` (read when present; ``Inputs.gyr`` is ``None`` otherwise, and the
-        methods that need it refuse by name in :func:`run`) and ``mag``; attrs ``fs``.
+        methods that need it refuse by name in :func:`run_method`) and ``mag``; attrs ``fs``.
     use_mag : bool
         Also read ``mag`` (9D).
     allow_nan : bool
         Accept NaN samples (dropouts), e.g. to split the recording into segments with
         :func:`tiltlab._validate.segments` (as ``estimate(..., gaps="segments")``
         does); the kernels themselves refuse NaN. Infinite values are always refused.
+
+    Returns
+    -------
+    Inputs
+        The sensor data in SI units, with ``fs`` and the accelerometer's labels.
 
     Raises
     ------
@@ -83,30 +100,30 @@ def prepare(
     -----
     The ``fs``/time-axis check compares the *median* time step with ``1/fs``: a time
     axis with a few long steps (dropped samples) passes here. :func:`estimate` looks
-    for such gaps (``gaps=``); code that calls :func:`run` directly should too
+    for such gaps (``gaps=``); code that calls :func:`run_method` directly should too
     (:func:`tiltlab._validate.segments`).
     """
-    if not isinstance(recording, xr.Dataset):
+    if not isinstance(rec, xr.Dataset):
         raise _v.RecordingError(
-            "recording must be an xarray Dataset (a tiltlab Recording), "
-            f"got {type(recording).__name__}"
+            "rec (the recording) must be an xarray Dataset (a tiltlab Recording), "
+            f"got {type(rec).__name__}"
         )
-    names = ["acc"] + (["gyr"] if "gyr" in recording else [])
+    names = ["acc"] + (["gyr"] if "gyr" in rec else [])
     names += ["mag"] if use_mag else []
     for name in names:
-        if name not in recording:
+        if name not in rec:
             hint = " (needed for use_mag=True)" if name == "mag" else ""
             raise _v.RecordingError(f"the Recording has no {name!r} variable{hint}")
-    rec = recording[names]
-    if "time" in rec.dims:
-        rec = rec.transpose("time", ...)
-    acc = _v.signal(rec, "acc", to_units="m/s^2", allow_nan=allow_nan)
+    sensors = rec[names]
+    if "time" in sensors.dims:
+        sensors = sensors.transpose("time", ...)
+    acc = _v.signal(sensors, "acc", to_units="m/s^2", allow_nan=allow_nan)
     gyr = (
-        _v.signal(rec, "gyr", to_units="rad/s", allow_nan=allow_nan).values
+        _v.signal(sensors, "gyr", to_units="rad/s", allow_nan=allow_nan).values
         if "gyr" in names
         else None
     )
-    mag = _v.signal(rec, "mag", allow_nan=allow_nan).values if use_mag else None
+    mag = _v.signal(sensors, "mag", allow_nan=allow_nan).values if use_mag else None
 
     def c(a):
         return None if a is None else np.ascontiguousarray(a, dtype=np.float64)
@@ -123,8 +140,8 @@ def _check_sensors(m, inputs: Inputs) -> None:
             )
 
 
-def run(method: str, inputs: Inputs, **params) -> np.ndarray:
-    """Run a registered method on prepared :class:`Inputs`; returns (N, 4) quaternions.
+def run_method(method: str, inputs: Inputs, **params) -> np.ndarray:
+    """Run a registered method on prepared :class:`Inputs`; return (N, 4) quaternions.
 
     Unspecified parameters take the registry's defaults; an unknown method or
     parameter is a ValueError naming it; a method that needs a sensor the inputs lack
@@ -151,8 +168,24 @@ def run(method: str, inputs: Inputs, **params) -> np.ndarray:
     return m(inputs.acc, inputs.gyr, inputs.fs, inputs.mag, **full)
 
 
+#: former name of :func:`run_method` (FutureWarning)
+run = alias(run_method, "run")
+
+
 def attr_value(v):
-    """A parameter value as a netCDF-friendly attribute (None → "none", bool → int)."""
+    """Convert a parameter value to a netCDF-friendly attribute.
+
+    Parameters
+    ----------
+    v : object
+        A parameter value.
+
+    Returns
+    -------
+    object
+        ``"none"`` for None, an int for a bool, a float array for an array, list or
+        tuple, else ``v`` itself.
+    """
     if v is None:
         return "none"
     if isinstance(v, (bool, np.bool_)):
@@ -163,7 +196,7 @@ def attr_value(v):
 
 
 #: values of ``estimate(..., gaps=)``
-GAP_POLICIES = ("raise", "segments")
+ESTIMATE_GAP_POLICIES = ("raise", "segments")
 
 
 def _time_axis(inputs: Inputs) -> np.ndarray:
@@ -173,8 +206,9 @@ def _time_axis(inputs: Inputs) -> np.ndarray:
     return t
 
 
+@renamed(recording="rec")
 def estimate(
-    recording: xr.Dataset,
+    rec: xr.Dataset,
     method: str,
     *,
     use_mag: bool = False,
@@ -190,10 +224,11 @@ def estimate(
 
     Parameters
     ----------
-    recording : xarray.Dataset
-        A tiltlab Recording (``acc``; ``gyr`` and ``mag`` optional; attrs ``fs``).
+    rec : xarray.Dataset
+        A tiltlab Recording (``acc``; ``gyr`` and ``mag`` optional; attrs ``fs``);
+        formerly ``recording``.
         Without ``gyr`` only the methods that need no gyroscope run
-        (``filters.methods(needs=recording)``: ``lowpass``, and ``davenport`` with a
+        (``filters.methods(needs=rec)``: ``lowpass``, and ``davenport`` with a
         magnetometer); any other is refused by name.
     method : str
         A name of :data:`tiltlab.filters.METHODS` (:func:`tiltlab.filters.methods`).
@@ -259,22 +294,22 @@ def estimate(
             "use_mag=True is not supported"
         )
     use_mag = bool(use_mag or m.requires_mag)
-    if not isinstance(gaps, str) or gaps not in GAP_POLICIES:
-        raise ValueError(f"gaps must be one of {GAP_POLICIES}, got {gaps!r}")
+    if not isinstance(gaps, str) or gaps not in ESTIMATE_GAP_POLICIES:
+        raise ValueError(f"gaps must be one of {ESTIMATE_GAP_POLICIES}, got {gaps!r}")
     min_segment_s = _v.nonnegative(min_segment_s, "min_segment_s")
     full = m.resolve(params)
-    if isinstance(recording, xr.Dataset):
-        have = [v for v in registry.SENSORS if v in recording]
+    if isinstance(rec, xr.Dataset):
+        have = [v for v in registry.SENSORS if v in rec]
         for name in m.needs:
             if name not in have:
                 raise _v.RecordingError(registry.missing_sensor_message(m, name, have))
-    inputs = prepare(recording, use_mag=use_mag, allow_nan=True)
+    inputs = prepare(rec, use_mag=use_mag, allow_nan=True)
     n = inputs.acc.shape[0]
     time = _time_axis(inputs)
     used = ["acc"] + (["gyr"] if m.uses_gyr else []) + (["mag"] if use_mag else [])
     stacked = [getattr(inputs, v) for v in used]
     segs = _v.segments(time, inputs.fs, values=np.concatenate(stacked, axis=1))
-    labels = recording.attrs.get("axis_labels")
+    labels = rec.attrs.get("axis_labels")
     attrs: dict[str, Any] = {
         "method": method,
         "use_mag": int(bool(use_mag)),
@@ -331,44 +366,5 @@ def estimate(
         "q",
         dims=("time", "quat"),
         coords={"quat": list("wxyz")},
-        attrs=attrs,
-    )
-
-
-def gravity(q):
-    r"""Tilt :math:`g_s = R(q)^\top e_z`: the gravity-up direction in the sensor frame.
-
-    Parameters
-    ----------
-    q : xarray.DataArray or array_like, shape (..., 4)
-        Quaternions sensor → world, e.g. the output of :func:`estimate` (a DataArray
-        with a ``quat`` dimension).
-
-    Returns
-    -------
-    xarray.DataArray or numpy.ndarray
-        For a DataArray: a DataArray named ``gravity`` with ``quat`` replaced by
-        ``axis`` (x, y, z), keeping the other coordinates (``time``) and the attrs
-        (``fs``, ``method``, parameters), with ``units = "1"`` and
-        ``frame = "sensor"``. For a plain array: an ndarray of shape (..., 3).
-    """
-    if not isinstance(q, xr.DataArray):
-        return quat.gravity(_v.vectors(q, "q", width=4, ndim=None, allow_nan=True))
-    if "quat" not in q.dims:
-        raise ValueError(f"q must have a 'quat' dimension, got dims {q.dims}")
-    qa = q.transpose(..., "quat")
-    g = quat.gravity(np.asarray(qa.values, dtype=float))
-    coords = {k: v for k, v in qa.coords.items() if "quat" not in v.dims}
-    attrs = {
-        **q.attrs,
-        "units": "1",
-        "frame": "sensor",
-        "long_name": "gravity-up direction (tilt)",
-    }
-    return xr.DataArray(
-        g,
-        dims=qa.dims[:-1] + ("axis",),
-        coords={**coords, "axis": list("xyz")},
-        name="gravity",
         attrs=attrs,
     )

@@ -7,7 +7,8 @@ signature with :mod:`inspect`, so that a default value is written in exactly one
 * ``defaults`` — the keyword-only parameters with a scalar default (``beta``,
   ``tau_acc_s``, …): the tunable parameters, recorded in :func:`estimate`'s attrs;
 * ``options`` — the array-valued initial-state arguments that :func:`estimate` passes
-  through (``q0``, ``b0``, ``P0``, ``bias``);
+  through (``q0``, ``gyr_offset``, ``P0``); a parameter's former name (see
+  :func:`tiltlab._deprecate.renamed`) is accepted with a FutureWarning;
 * ``supports_mag`` — the function has a ``mag`` argument (9D possible), unless the
   entry is marked ``six_d`` (an adapter that keeps ``mag=None`` only for the uniform
   signature: RIANN);
@@ -27,6 +28,7 @@ Adapters to the ``vqf`` package also accept that package's own parameters
 from __future__ import annotations
 
 import inspect
+import warnings
 from collections.abc import Callable, Collection, Mapping
 from dataclasses import dataclass
 from types import MappingProxyType
@@ -47,6 +49,7 @@ from .mahony import mahony
 from .rts import rts_smoother
 from .smoothers import smoother
 from .vectors import davenport, magnetic_dip
+from ._docs import shared_docs
 
 __all__ = [
     "Method",
@@ -83,7 +86,7 @@ PARAMETER_UNITS: Mapping[str, str] = MappingProxyType(
 #: keyword arguments that are never parameters of :func:`estimate`
 _NOT_PARAMS = frozenset({"mag", "return_bias", "return_state"})
 #: array-valued keyword arguments (initial state): passed through, not tunable
-_OPTIONS = frozenset({"q0", "b0", "P0", "bias"})
+_OPTIONS = frozenset({"q0", "gyr_offset", "P0"})
 #: kinds of method
 KINDS = ("causal", "offline", "adapter")
 
@@ -160,8 +163,10 @@ class Method:
 
     @property
     def needs(self) -> tuple[str, ...]:
-        """The Recording variables the method cannot run without (``acc`` always,
-        ``gyr`` when it integrates the gyroscope, ``mag`` when it requires one).
+        """The Recording variables the method cannot run without.
+
+        ``acc`` always, ``gyr`` when it integrates the gyroscope, ``mag`` when it
+        requires one.
         """
         return (
             ("acc",)
@@ -170,16 +175,30 @@ class Method:
         )
 
     def resolve(self, params: Mapping[str, Any]) -> dict[str, Any]:
-        """``defaults`` updated with ``params``; an unknown name is a ValueError."""
+        """Return ``defaults`` updated with ``params``; an unknown name is a ValueError.
+
+        A parameter's former name (``b0`` for ``gyr_offset``) is translated, with a
+        FutureWarning.
+
+        Parameters
+        ----------
+        params : mapping
+            Parameter values by name.
+
+        Returns
+        -------
+        dict
+            Every parameter of the method with its value.
+        """
+        params = _current_names(self.function, params)
         known = set(self.defaults) | set(self.options)
         extra = set(self.extra_params()) if self.extra_params else set()
-        unknown = [k for k in params if k not in known and k not in extra]
+        unknown, hint = _v.unknown_keys(
+            params,
+            known | extra,
+            hints={"mag": " (pass use_mag=True to use the magnetometer)"},
+        )
         if unknown:
-            hint = (
-                " (pass use_mag=True to use the magnetometer)"
-                if "mag" in unknown
-                else ""
-            )
             valid = sorted(known) + (["<vqf parameters>"] if extra else [])
             raise ValueError(
                 f"unknown parameter(s) {unknown} for method {self.name!r}{hint}; "
@@ -207,6 +226,27 @@ class Method:
         return self.function(acc, fs, **kw)
 
 
+def _current_names(function: Callable[..., Any], params: Mapping[str, Any]) -> dict:
+    """Translate the former names of renamed parameters, with a FutureWarning."""
+    old_to_new = getattr(function, "__renamed__", {})
+    out = {}
+    for k, v in params.items():
+        if k in old_to_new:
+            new = old_to_new[k]
+            if new in params:
+                raise TypeError(f"pass {new!r} only ({k!r} is its old name)")
+            warnings.warn(
+                f"{function.__name__}: {k!r} was renamed {new!r}; the old name goes "
+                "in the next release",
+                FutureWarning,
+                stacklevel=4,
+            )
+            k = new
+        out[k] = v
+    return out
+
+
+@shared_docs
 def vector_observation(
     acc,
     fs: float | None = None,
@@ -215,8 +255,10 @@ def vector_observation(
     dip: float | None = None,
     cutoff_hz: float | None = None,
 ):
-    r"""Orientation from the accelerometer and magnetometer alone, sample by sample
-    (Davenport's q-method, :func:`tiltlab.filters.davenport`); no gyroscope.
+    r"""Estimate the orientation from the accelerometer and magnetometer alone.
+
+    Sample by sample (Davenport's q-method, :func:`tiltlab.filters.davenport`); no
+    gyroscope.
 
     The gravity-up observation is the specific force and the north observation the
     magnetic field; :math:`q_k` maximises Wahba's gain
@@ -229,9 +271,7 @@ def vector_observation(
     ----------
     acc : array_like or xarray.DataArray, shape (N, 3)
         Specific force (any unit; only its direction is used).
-    fs : float, optional
-        Sampling rate (Hz): mandatory for plain arrays; with labelled inputs it may
-        be omitted when they carry ``attrs["fs"]``, and must agree with it when given.
+    %(fs)s
     mag : array_like or xarray.DataArray, shape (N, 3)
         Magnetic field (any unit; only its direction is used). Required. Labelled
         inputs are read as in the filters (:mod:`tiltlab.filters`, "Labelled
@@ -381,7 +421,7 @@ METHODS: Mapping[str, Method] = _registry(
 
 
 def _available(needs: Any) -> frozenset[str]:
-    """The sensor variables named by ``needs`` (a name, names, or a Recording)."""
+    """Return the sensor variables named by ``needs`` (a name, names, or a Recording)."""
     if isinstance(needs, Mapping) or hasattr(needs, "data_vars"):
         return frozenset(v for v in SENSORS if v in needs)
     names = (needs,) if isinstance(needs, str) else tuple(needs)
@@ -399,8 +439,7 @@ def _available(needs: Any) -> frozenset[str]:
 
 
 def methods(kind: str | None = None, *, needs: Any = None) -> tuple[str, ...]:
-    """Names of the registered methods, optionally of one ``kind`` and runnable on the
-    given sensors.
+    """List the registered methods, optionally of one ``kind`` and runnable on sensors.
 
     Parameters
     ----------
@@ -414,6 +453,7 @@ def methods(kind: str | None = None, *, needs: Any = None) -> tuple[str, ...]:
     Returns
     -------
     tuple of str
+        Method names, in registry order.
 
     Examples
     --------
@@ -435,7 +475,7 @@ def methods(kind: str | None = None, *, needs: Any = None) -> tuple[str, ...]:
 def missing_sensor_message(
     method: Method | str, missing: str, have: Collection[str] = ("acc",)
 ) -> str:
-    """The message refusing ``method`` on data without the variable ``missing``.
+    """Write the message refusing ``method`` on data without the variable ``missing``.
 
     It names the method and the sensor it needs, and lists the methods that run on the
     variables ``have`` (and those that would with a magnetometer too).
@@ -472,8 +512,9 @@ def missing_sensor_message(
 
 
 def get_method(name: str) -> Method:
-    """The registry entry of ``name``; an unknown name is a ValueError listing the
-    valid ones.
+    """Return the registry entry of ``name``.
+
+    An unknown name is a ValueError listing the valid ones.
 
     Parameters
     ----------

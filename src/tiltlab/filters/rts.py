@@ -5,21 +5,39 @@ bounded-position pseudo-measurements; adaptive accelerometer weighting.
 
 This module holds the public :func:`rts_smoother` (its parameters, initial state and
 noise) and the plan of the arrays it allocates (:func:`_rts_plan`); the numba kernels
-are in :mod:`tiltlab.filters._rts_steps` (one sample of the forward filter and of the
-backward pass) and :mod:`tiltlab.filters._rts_kernel` (the passes over a recording).
+are in :mod:`tiltlab.filters._rts_kernel` (one sample of the forward filter and of the
+backward pass, and the passes over a recording); :func:`_rts_params` maps the tuning
+options (:class:`RtsTuning`) to the kernels' parameter record.
 """
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 
 from .. import _validate as _v
-from ._common import samples, start_orientation, unlabel
-from ._rts_kernel import _rts_kernel
-from ._rts_steps import _RTS_N, _RTS_X
+from .._deprecate import renamed
+from ._common import (
+    check_tuning,
+    offset_vector,
+    samples,
+    start_orientation,
+    tuned,
+    unlabel,
+)
+from ._rts_kernel import (
+    _RTS_N,
+    _RTS_X,
+    RtsArrays,
+    RtsInputs,
+    RtsParams,
+    _rts_kernel,
+)
 from .smoothers import rest_gyro_bias
+from ._docs import shared_docs
 
-__all__ = ["rts_smoother"]
+__all__ = ["RtsTuning", "rts_smoother"]
 
 #: samples per block of the checkpointed backward pass (see :func:`_rts_plan`; ``None``:
 #: store every sample, the full-storage smoother)
@@ -30,6 +48,27 @@ _RTS_BLOCK_SAMPLE_BYTES = 8 * (2 * (4 + _RTS_X) + _RTS_N * _RTS_N)  # 2056
 _RTS_CKPT_BYTES = 8 * (4 + _RTS_X + _RTS_N * _RTS_N)  # 1928
 
 
+class RtsTuning(NamedTuple):
+    """Tuning options of :func:`rts_smoother` and their defaults (see its parameters)."""
+
+    gyr_noise: float = 5e-3
+    bias_noise: float = 1e-4
+    acc_noise: float = 0.01
+    acc_std: float = 0.05
+    norm_gain: float = 10.0
+    vel_std: float = 0.3
+    pos_std: float = 1.0
+    tau_s: float = 1.0
+    zupt_std: float = 0.01
+    bias_std: float = float(np.radians(0.5))
+    scale_std: float = 0.0
+    scale_noise: float = 0.0
+
+
+#: options of :class:`RtsTuning` that must be > 0 (all but ``tau_s`` may be ``inf``)
+_POSITIVE = ("tau_s", "acc_std", "vel_std", "pos_std", "zupt_std")
+
+
 def _rts_plan(
     n_samples: int,
     block: int | None,
@@ -37,8 +76,9 @@ def _rts_plan(
     smooth: bool = True,
     return_state: bool = False,
 ) -> dict:
-    """The arrays :func:`rts_smoother` allocates for ``n_samples`` samples: their shapes
-    (``shapes``: name → shape, every array float64) and bytes.
+    """Plan the arrays :func:`rts_smoother` allocates for ``n_samples`` samples.
+
+    Their shapes (``shapes``: name → shape, every array float64) and bytes.
 
     ``block``: samples per block of the backward pass (:func:`rts_smoother` uses
     :data:`_RTS_BLOCK`); ``None`` or ``≥ n_samples − 1``: one block, i.e. the
@@ -86,32 +126,26 @@ def _rts_plan(
     return plan
 
 
+@renamed(bias="gyr_offset")
+@tuned(RtsTuning)
+@shared_docs
 def rts_smoother(
     acc,
     gyr,
     fs: float | None = None,
     *,
-    gyr_noise: float = 5e-3,
-    bias_noise: float = 1e-4,
-    acc_noise: float = 0.01,
-    acc_std: float = 0.05,
-    norm_gain: float = 10.0,
-    vel_std: float = 0.3,
-    pos_std: float = 1.0,
-    tau_s: float = 1.0,
-    zupt_std: float = 0.01,
-    bias_std: float = float(np.radians(0.5)),
-    scale_std: float = 0.0,
-    scale_noise: float = 0.0,
-    bias=None,
+    tuning: RtsTuning,
+    gyr_offset=None,
     q0=None,
     init_window_s: float = 0.1,
     smooth: bool = True,
     return_state: bool = False,
     max_memory_gb: float = 4.0,
 ):
-    r"""Offline attitude smoother: error-state (multiplicative) EKF with gyro-bias, gyro-scale,
-    velocity and position states, followed by a Rauch–Tung–Striebel backward pass.
+    r"""Smooth the attitude offline: an error-state EKF and a Rauch–Tung–Striebel pass.
+
+    The error-state (multiplicative) EKF has gyro-bias, gyro-scale, velocity and
+    position states; a Rauch–Tung–Striebel backward pass follows.
 
     **Nominal state** :math:`x = (q, b, v, p, s)`: attitude (sensor → world, z up), gyro bias
     (rad/s), world-frame velocity (m/s) and position (m) of the sensor, and gyro scale
@@ -178,9 +212,7 @@ def rts_smoother(
     gyr : array_like or xarray.DataArray, shape (N, 3)
         Angular velocity (rad/s); a labelled DataArray is converted from its ``units``
         attribute (required; see :mod:`tiltlab.filters`, "Labelled inputs").
-    fs : float, optional
-        Sampling rate (Hz): mandatory for plain arrays; with labelled inputs it may
-        be omitted when they carry ``attrs["fs"]``, and must agree with it when given.
+    %(fs)s
     gyr_noise : float
         Angular random walk σ_ω (rad/√s), gyro noise plus unmodelled scale errors.
     bias_noise : float
@@ -203,14 +235,11 @@ def rts_smoother(
     scale_std, scale_noise : float
         Initial standard deviation (1) and random walk (1/√s) of the gyro scale errors;
         the default 0 switches scale estimation off.
-    bias : array_like, shape (3,), optional
-        Initial gyro bias (rad/s, whatever the units of a labelled ``gyr``); default
-        :func:`rest_gyro_bias`.
-    q0 : array_like, shape (4,), optional
-        Initial orientation; default :func:`initial_orientation` over
-        ``init_window_s`` seconds.
-    init_window_s : float
-        Initialisation window (s).
+    gyr_offset : array_like, shape (3,), optional
+        Initial gyroscope offset (bias; rad/s, whatever the units of a labelled
+        ``gyr``); default :func:`rest_gyro_bias`. Formerly ``bias`` (still accepted,
+        with a FutureWarning).
+    %(q0_init)s
     smooth : bool
         Run the backward pass (``False``: forward filter only).
     return_state : bool
@@ -267,10 +296,29 @@ def rts_smoother(
     plan = _rts_plan(
         acc.shape[0], _RTS_BLOCK, smooth=bool(smooth), return_state=bool(return_state)
     )
+    _check_memory(plan, acc.shape[0], max_memory_gb, bool(smooth))
+    tuning = check_tuning(tuning, positive=_POSITIVE, inf=_POSITIVE[1:])
+    b_rest, rest = rest_gyro_bias(acc, gyr, fs)
+    b0 = offset_vector(gyr_offset, b_rest)
+    an = np.linalg.norm(acc, axis=1)
+    grav = float(np.mean(an[rest])) if rest.sum() >= 0.5 * fs else float(np.median(an))
+    if not grav > 0:
+        raise ValueError("the accelerometer norm vanishes; no gravity can be defined")
+    q0 = start_orientation(q0, acc, None, fs, init_window_s)
+    params, Qd, P0 = _rts_params(tuning, fs, grav)
+    inputs = RtsInputs(acc, gyr, np.ascontiguousarray(rest), Qd)
+    arrays = RtsArrays(*(np.empty(v) for v in plan["shapes"].values()))
+    x0 = np.concatenate([b0, np.zeros(9)])
+    _rts_kernel(inputs, params, q0, x0, P0, arrays, bool(smooth))
+    return (arrays.out_q, arrays.out_x) if return_state else arrays.out_q
+
+
+def _check_memory(plan: dict, n: int, max_memory_gb: float, smooth: bool) -> None:
+    """Refuse a plan over ``max_memory_gb`` (smoothing only), explaining its parts."""
     need_gb = plan["total_bytes"] / 1e9
     if smooth and need_gb > max_memory_gb:
         raise ValueError(
-            f"rts_smoother would allocate {need_gb:.3g} GB for {acc.shape[0]} samples "
+            f"rts_smoother would allocate {need_gb:.3g} GB for {n} samples "
             f"(limit max_memory_gb={max_memory_gb:g}): the output "
             f"({plan['output_bytes'] / 1e9:.3g} GB, 32 B per sample, 128 B with "
             f"return_state), {plan['checkpoints']} checkpoints "
@@ -278,78 +326,48 @@ def rts_smoother(
             f"{plan['block']} samples ({plan['block_bytes'] / 1e9:.3g} GB); split "
             "the recording into shorter segments or raise the limit"
         )
+
+
+def _rts_params(
+    t: RtsTuning, fs: float, grav: float
+) -> tuple[RtsParams, np.ndarray, np.ndarray]:
+    """Map the (checked) tuning options to the kernels' model.
+
+    The one place where the public options become the kernels' values: the scalar
+    parameters (:class:`~tiltlab.filters._rts_kernel.RtsParams`: the pseudo-measurement
+    standard deviations per correlation time become variances per sample), the
+    diagonal of the discrete process noise and the initial covariance.
+    """
     dt = 1.0 / fs
-    sig = [
-        _v.nonnegative(gyr_noise, "gyr_noise"),
-        _v.nonnegative(bias_noise, "bias_noise"),
-        _v.nonnegative(acc_noise, "acc_noise"),
-    ]
-    tau_s = _v.positive(tau_s, "tau_s")
-    std = {
-        nm: _v.positive(v, nm, allow_inf=True)
-        for nm, v in (
-            ("acc_std", acc_std),
-            ("vel_std", vel_std),
-            ("pos_std", pos_std),
-            ("zupt_std", zupt_std),
-        )
-    }
-    norm_gain = _v.nonnegative(norm_gain, "norm_gain")
-    bias_std = _v.nonnegative(bias_std, "bias_std")
-    scale_std = _v.nonnegative(scale_std, "scale_std")
-    scale_noise = _v.nonnegative(scale_noise, "scale_noise")
-    b_rest, rest = rest_gyro_bias(acc, gyr, fs)
-    if bias is None:
-        b0 = b_rest
-    else:
-        b0 = _v.vectors(np.reshape(bias, -1), "bias", width=3, ndim=1)
-    an = np.linalg.norm(acc, axis=1)
-    grav = float(np.mean(an[rest])) if rest.sum() >= 0.5 * fs else float(np.median(an))
-    if not grav > 0:
-        raise ValueError("the accelerometer norm vanishes; no gravity can be defined")
-    q0 = start_orientation(q0, acc, None, fs, init_window_s)
-    x0 = np.concatenate([b0, np.zeros(9)])
+    rate = t.tau_s * fs
+    params = RtsParams(
+        dt=dt,
+        grav=grav,
+        var_acc=t.acc_std**2 * rate,
+        norm_gain=t.norm_gain,
+        var_vel=t.vel_std**2 * rate,
+        var_pos=t.pos_std**2 * rate,
+        var_zupt=t.zupt_std**2,
+    )
+    Qd = (
+        dt
+        * np.r_[
+            [t.gyr_noise**2] * 3,
+            [t.bias_noise**2] * 3,
+            [t.acc_noise**2] * 3,
+            [t.acc_noise**2 * dt * dt / 3.0] * 3,
+            [t.scale_noise**2] * 3,
+        ]
+    )
     P0 = np.diag(
         np.r_[
             np.radians(2.0) ** 2,
             np.radians(2.0) ** 2,
             1e-6,
-            [bias_std**2 + 1e-12] * 3,
+            [t.bias_std**2 + 1e-12] * 3,
             [0.1**2] * 3,
             [1e-6] * 3,
-            [scale_std**2 + 1e-12] * 3,
+            [t.scale_std**2 + 1e-12] * 3,
         ]
     )
-    Qd = (
-        dt
-        * np.r_[
-            [sig[0] ** 2] * 3,
-            [sig[1] ** 2] * 3,
-            [sig[2] ** 2] * 3,
-            [sig[2] ** 2 * dt * dt / 3.0] * 3,
-            [scale_noise**2] * 3,
-        ]
-    )
-    Qd = np.maximum(Qd, 1e-18)
-    rate = tau_s * fs
-    arrays = {k: np.empty(v) for k, v in plan["shapes"].items()}
-    _rts_kernel(
-        acc,
-        gyr,
-        np.ascontiguousarray(rest),
-        dt,
-        grav,
-        q0,
-        x0,
-        P0,
-        Qd,
-        std["acc_std"] ** 2 * rate,
-        norm_gain,
-        std["vel_std"] ** 2 * rate,
-        std["pos_std"] ** 2 * rate,
-        std["zupt_std"] ** 2,
-        bool(smooth),
-        *arrays.values(),
-    )
-    out_q, out_x = arrays["out_q"], arrays["out_x"]
-    return (out_q, out_x) if return_state else out_q
+    return params, np.maximum(Qd, 1e-18), P0

@@ -7,11 +7,20 @@ import numpy as np
 from .. import _validate as _v
 from .. import dsp
 from .. import quaternion as quat
-from ._common import samples, start_orientation, tilt_quaternion, unlabel
+from .._deprecate import renamed
+from ._common import (
+    offset_vector,
+    samples,
+    start_orientation,
+    tilt_quaternion,
+    unlabel,
+)
+from ._docs import shared_docs
 
 __all__ = ["rest_gyro_bias", "smoother"]
 
 
+@shared_docs
 def rest_gyro_bias(
     acc,
     gyr,
@@ -40,9 +49,7 @@ def rest_gyro_bias(
         Angular velocity (rad/s; a labelled DataArray is converted to rad/s from its
         ``units`` attribute, which it must have; see :mod:`tiltlab.filters`,
         "Labelled inputs").
-    fs : float, optional
-        Sampling rate (Hz): mandatory for plain arrays; with labelled inputs it may
-        be omitted when they carry ``attrs["fs"]``, and must agree with it when given.
+    %(fs)s
     window_s : float
         Smoothing window (s).
     threshold_rad_s : float
@@ -58,6 +65,7 @@ def rest_gyro_bias(
     bias : numpy.ndarray, shape (3,)
         In rad/s (also for a labelled ``gyr``).
     rest : numpy.ndarray of bool, shape (N,)
+        The rest samples.
     """
     fs, acc, gyr, _ = unlabel(fs, acc=acc, gyr=gyr, acc_si=True)
     acc = samples(acc, "acc")
@@ -76,6 +84,8 @@ def rest_gyro_bias(
     return bias, rest
 
 
+@renamed(bias="gyr_offset")
+@shared_docs
 def smoother(
     acc,
     gyr,
@@ -83,11 +93,13 @@ def smoother(
     *,
     cutoff_hz: float = 0.1,
     order: int = 2,
-    bias=None,
+    gyr_offset=None,
     q0=None,
 ) -> np.ndarray:
-    r"""Offline (non-causal) tilt smoother: zero-phase low-pass of the specific force in
-    the gyroscope-integrated frame.
+    r"""Smooth the tilt offline: zero-phase low-pass of the gyro-integrated specific force.
+
+    The non-causal smoother low-passes the specific force in the gyroscope-integrated
+    frame:
 
     1. Gyro bias :math:`b` from rest periods (:func:`rest_gyro_bias`) unless given.
     2. Strapdown integration :math:`q_g` of :math:`\omega - b` (any start). Because
@@ -114,16 +126,16 @@ def smoother(
     gyr : array_like or xarray.DataArray, shape (N, 3)
         Angular velocity (rad/s); a labelled DataArray is converted from its ``units``
         attribute (required; see :mod:`tiltlab.filters`, "Labelled inputs").
-    fs : float, optional
-        Sampling rate (Hz): mandatory for plain arrays; with labelled inputs it may
-        be omitted when they carry ``attrs["fs"]``, and must agree with it when given.
+    %(fs)s
     cutoff_hz : float
         Cut-off (Hz) of the low-pass: below the motion frequencies, above the drift of
         :math:`D` (bias residual, gyro scale errors).
     order : int
         Butterworth order of each pass.
-    bias : array_like, shape (3,), optional
-        Known gyro bias (rad/s, whatever the units of a labelled ``gyr``).
+    gyr_offset : array_like, shape (3,), optional
+        Known gyroscope offset (bias; rad/s, whatever the units of a labelled
+        ``gyr``); default :func:`rest_gyro_bias`. Formerly ``bias`` (still accepted,
+        with a FutureWarning).
     q0 : array_like, shape (4,), optional
         Start of the integration (fixes the heading origin); default identity.
 
@@ -134,10 +146,10 @@ def smoother(
     fs, acc, gyr, _ = unlabel(fs, acc=acc, gyr=gyr, acc_si=True)
     acc = samples(acc, "acc")
     gyr = samples(gyr, "gyr", acc.shape[0])
-    if bias is None:
+    if gyr_offset is None:
         b = rest_gyro_bias(acc, gyr, fs)[0]
     else:
-        b = _v.vectors(np.reshape(bias, -1), "bias", width=3, ndim=1)
+        b = offset_vector(gyr_offset)
     w = gyr - b
     q0 = quat.identity() if q0 is None else start_orientation(q0, acc, None, fs, 0.0)
     # filters' indexing: q[k] = q[k-1] ⊗ exp(ω_k Δt / 2)

@@ -1,5 +1,6 @@
-r"""Orientation from vector observations, sample by sample: Davenport's q-method, the
-optimum that QUEST approximates.
+r"""Estimate orientations from vector observations, sample by sample (Davenport).
+
+Davenport's q-method is the optimum that QUEST approximates.
 
 Wahba's problem: find the rotation :math:`A` (world → sensor) minimising
 :math:`\tfrac12 \sum_i a_i \lVert b_i - A r_i \rVert^2` for unit observations
@@ -52,10 +53,23 @@ def _unit_rows(v, name: str) -> np.ndarray:
     return v / n
 
 
+def _unit_pairs(acc, mag) -> tuple[np.ndarray, np.ndarray]:
+    """Read labelled or plain ``acc`` and ``mag`` as unit rows of the same shape."""
+    _, acc, _, mag = unlabel(None, acc=acc, mag=mag, need_fs=False)
+    a = _unit_rows(acc, "acc")
+    m = _unit_rows(mag, "mag")
+    if a.shape != m.shape:
+        raise ValueError(
+            f"acc and mag must have the same shape, got {a.shape}, {m.shape}"
+        )
+    return a, m
+
+
 def magnetic_dip(acc, mag) -> float:
-    r"""Dip angle :math:`\delta` (rad, positive when the field points below the horizon)
-    from sensor-frame specific force and field samples: the mean of
-    :math:`\arcsin(\hat m \cdot (-\hat a))`.
+    r"""Measure the magnetic dip angle :math:`\delta` from specific force and field samples.
+
+    The dip is positive (rad) when the field points below the horizon: the mean of
+    :math:`\arcsin(\hat m \cdot (-\hat a))` over the sensor-frame samples.
 
     Parameters
     ----------
@@ -68,20 +82,16 @@ def magnetic_dip(acc, mag) -> float:
     Returns
     -------
     float
+        The dip (rad).
     """
-    _, acc, _, mag = unlabel(None, acc=acc, mag=mag, need_fs=False)
-    a = _unit_rows(acc, "acc")
-    m = _unit_rows(mag, "mag")
-    if a.shape != m.shape:
-        raise ValueError(
-            f"acc and mag must have the same shape, got {a.shape}, {m.shape}"
-        )
+    a, m = _unit_pairs(acc, mag)
     return float(np.mean(np.arcsin(np.clip(-np.sum(a * m, axis=1), -1.0, 1.0))))
 
 
 def davenport(acc, mag, *, dip: float, weights: tuple[float, float] = (1.0, 1.0)):
-    r"""Orientation (sensor → world, ENU) of every sample from its accelerometer and
-    magnetometer vectors by Davenport's q-method.
+    r"""Estimate each sample's orientation from its acc and mag vectors (Davenport).
+
+    Sensor → world, ENU, by Davenport's q-method.
 
     Parameters
     ----------
@@ -111,13 +121,7 @@ def davenport(acc, mag, *, dip: float, weights: tuple[float, float] = (1.0, 1.0)
     is shared; with a dominant accelerometer weight it tends to TRIAD with gravity as
     the primary vector.
     """
-    _, acc, _, mag = unlabel(None, acc=acc, mag=mag, need_fs=False)
-    a = _unit_rows(acc, "acc")
-    m = _unit_rows(mag, "mag")
-    if a.shape != m.shape:
-        raise ValueError(
-            f"acc and mag must have the same shape, got {a.shape}, {m.shape}"
-        )
+    a, m = _unit_pairs(acc, mag)
     dip = _v.finite(dip, "dip")
     w_a = _v.positive(weights[0], "weights[0]")
     w_m = _v.positive(weights[1], "weights[1]")
