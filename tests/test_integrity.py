@@ -226,43 +226,43 @@ def test_tampered_committed_weights_are_refused(learn, tmp_path):
     folder = shutil.copytree(COMMITTED, tmp_path / "learn")
     _flip_tensor_bit(COMMITTED / "gain_fold0.pt", folder / "gain_fold0.pt")
     with pytest.raises(IntegrityError, match=r"gain_fold0\.pt.*SHA256SUMS"):
-        learn.load(folder / "gain_fold0.pt")
+        learn.load_model(folder / "gain_fold0.pt")
     with pytest.raises(ValueError, match=r"gain_fold0\.pt"):
         learn.check_files(folder)
     with pytest.raises(IntegrityError, match=r"gain_fold0\.pt"):
         learn.learned_estimate(None, folder / "gain_fold0.pt")  # before any data
-    model, cfg, fs = learn.load(folder / "gain_fold0.pt", verify=False)
+    model, cfg, fs = learn.load_model(folder / "gain_fold0.pt", verify=False)
     assert cfg.variant == "gain"
     # the intact committed file loads, checked against its entry
-    learn.load(COMMITTED / "gain_fold0.pt")
+    learn.load_model(COMMITTED / "gain_fold0.pt")
 
 
 def test_saved_weights_carry_their_digest(learn, tmp_path, recwarn):
     cfg = learn.TrainConfig(variant="gain")
     model = learn.build_model(cfg, 285.0)
     digest = learn.save(model, cfg, 285.0, tmp_path / "m.pt")
-    loaded, cfg2, fs = learn.load(tmp_path / "m.pt")  # no SHA256SUMS: the digest
+    loaded, cfg2, fs = learn.load_model(tmp_path / "m.pt")  # no SHA256SUMS: the digest
     assert cfg2 == cfg and fs == 285.0 and not recwarn.list
-    learn.load(tmp_path / "m.pt", sha256=digest)
+    learn.load_model(tmp_path / "m.pt", sha256=digest)
     _flip_tensor_bit(tmp_path / "m.pt", tmp_path / "bad.pt")
     with pytest.raises(IntegrityError, match=r"bad\.pt.*saved with them"):
-        learn.load(tmp_path / "bad.pt")
+        learn.load_model(tmp_path / "bad.pt")
     with pytest.raises(IntegrityError, match=r"bad\.pt.*expected sha256"):
-        learn.load(tmp_path / "bad.pt", sha256=digest)
-    learn.load(tmp_path / "bad.pt", verify=False)
+        learn.load_model(tmp_path / "bad.pt", sha256=digest)
+    learn.load_model(tmp_path / "bad.pt", verify=False)
 
 
 def test_weights_with_no_record_load_with_a_warning(learn, tmp_path):
     shutil.copy(COMMITTED / "gain_fold0.pt", tmp_path / "alone.pt")
     with pytest.warns(UserWarning, match=r"alone\.pt: no recorded sha256"):
-        learn.load(tmp_path / "alone.pt")
+        learn.load_model(tmp_path / "alone.pt")
 
 
 def test_a_stale_sums_entry_refuses_replaced_weights(learn, tmp_path):
     shutil.copy(COMMITTED / "gain_fold0.pt", tmp_path / "quaternion_fold0.pt")
     shutil.copy(COMMITTED / "SHA256SUMS", tmp_path)
     with pytest.raises(IntegrityError, match="quaternion_fold0.pt"):
-        learn.load(tmp_path / "quaternion_fold0.pt")
+        learn.load_model(tmp_path / "quaternion_fold0.pt")
 
 
 # ------------------------------------------------------------------ SHA256SUMS

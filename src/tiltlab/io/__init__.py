@@ -1,6 +1,8 @@
-"""Readers and writers. I/O only: each reader parses a file into a Recording
-(:mod:`tiltlab.schema`) without any processing beyond unit labelling and axis mapping,
-and each writer stores one losslessly.
+"""Read and write recordings: one module per format, every reader giving a Recording.
+
+I/O only: each reader parses a file into a Recording (:mod:`tiltlab.schema`) without
+any processing beyond unit labelling and axis mapping, and each writer stores one
+losslessly.
 
 Supported formats
 -----------------
@@ -10,7 +12,8 @@ Supported formats
   the tumble test (``read_fayat_tumble``).
 * BROAD benchmark trials, ``.hdf5`` and MATLAB ``.mat`` layouts (``read_broad``).
 * A generic CSV with a column/unit mapping (``read_csv``), the mapping given as a dict
-  or a JSON file (``read_csv_mapping``); time columns in s, ms, µs, ns or date-times,
+  or a JSON file, checked into a :class:`CsvMapping` record (``read_csv_mapping``,
+  ``CsvMapping.load``); time columns in s, ms, µs, ns or date-times,
   on a regular grid or resampled from a jittery clock (``clock="resample"``);
   ``try_read`` returns why a file is refused instead of raising.
 * Exports with one file per sensor, each on its own clock (``read_multi``).
@@ -31,10 +34,17 @@ from __future__ import annotations
 from ._common import IntegrityError, ReadError
 from .broad import read_broad
 from .check import try_read
-from .csv import FS_RANGE, GAP_POLICIES, TIME_UNITS, read_csv, read_csv_mapping
+from .csv import (
+    FS_RANGE,
+    READ_GAP_POLICIES,
+    TIME_UNITS,
+    CsvMapping,
+    read_csv,
+    read_csv_mapping,
+)
 from .detect import detect, read
 from .fayat import read_fayat_imu, read_fayat_tumble
-from .mapping import mapping_template
+from .templates import mapping_template
 from .mat import read_matrix
 from .multi import read_multi
 from .ncfile import netcdf_format, open_netcdf
@@ -57,6 +67,7 @@ __all__ = [
     "read_broad",
     "read_csv",
     "read_csv_mapping",
+    "CsvMapping",
     "try_read",
     "read_tagtools",
     "write_tagtools",
@@ -65,10 +76,25 @@ __all__ = [
     "mapping_template",
     "TIME_UNITS",
     "FS_RANGE",
-    "GAP_POLICIES",
+    "READ_GAP_POLICIES",
     "save_netcdf",
     "load_netcdf",
     "open_netcdf",
     "netcdf_format",
     "netcdf_checksums",
 ]
+
+
+def __getattr__(name: str):
+    """Resolve the old name ``GAP_POLICIES`` (now :data:`READ_GAP_POLICIES`), warning."""
+    if name == "GAP_POLICIES":
+        import warnings
+
+        warnings.warn(
+            "tiltlab.io.GAP_POLICIES was renamed READ_GAP_POLICIES; the old name goes "
+            "in the next release",
+            FutureWarning,
+            stacklevel=2,
+        )
+        return READ_GAP_POLICIES
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -9,6 +9,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from .. import schema
+
 PathLike = str | os.PathLike
 
 
@@ -40,8 +42,41 @@ def _integrity_error(message, path, variable):
     return IntegrityError(message, path=path, variable=variable)
 
 
+def file_head(path: PathLike, size: int) -> bytes | None:
+    """Read the first bytes of a file, where a format states its signature.
+
+    Parameters
+    ----------
+    path : path-like
+        The file.
+    size : int
+        How many bytes to read (fewer if the file is shorter).
+
+    Returns
+    -------
+    bytes or None
+        The bytes, or None if the file cannot be opened.
+    """
+    try:
+        with open(path, "rb") as f:
+            return f.read(size)
+    except OSError:
+        return None
+
+
 def no_file(path) -> str:
-    """Why ``path`` cannot be read as a file: it is a folder, or nothing is there."""
+    """Say why ``path`` cannot be read as a file: it is a folder, or nothing is there.
+
+    Parameters
+    ----------
+    path : path-like
+        The path that is not a file.
+
+    Returns
+    -------
+    str
+        The message, starting with the path.
+    """
     p = Path(path)
     return f"{p}: is a directory, not a file" if p.is_dir() else f"{p}: no such file"
 
@@ -78,8 +113,24 @@ def _missing_columns_message(
 
 
 def read_table_or_fail(path, **kwargs) -> pd.DataFrame:
-    """:func:`pandas.read_csv`, its parse errors raised as one :class:`ReadError`
-    naming the file.
+    """Read a table with :func:`pandas.read_csv`, raising its parse errors as ReadError.
+
+    Parameters
+    ----------
+    path : path-like
+        CSV file.
+    **kwargs
+        Options for :func:`pandas.read_csv`.
+
+    Returns
+    -------
+    pandas.DataFrame
+        The table.
+
+    Raises
+    ------
+    ReadError
+        Naming the file, for any parse error.
     """
     try:
         return pd.read_csv(path, **kwargs)
@@ -147,3 +198,43 @@ def _read_table(
     if len(numeric) < 2:
         raise ReadError(f"{path}: fewer than two samples")
     return numeric
+
+
+def sensor_recording(
+    get: Mapping[str, np.ndarray],
+    fs: float,
+    units: Mapping[str, str | None],
+    **options,
+):
+    """Build a Recording from the sensors a reader found, each with its unit.
+
+    Parameters
+    ----------
+    get : mapping
+        Variable (``acc`` required; ``gyr``, ``mag``, ``temp``, ``q_ref``) → samples;
+        ``temp`` may be (N,) or (N, 1).
+    fs : float
+        Sampling rate (Hz).
+    units : mapping
+        Variable → unit, for every sensor in ``get``.
+    **options
+        Any other argument of :func:`tiltlab.schema.make_recording`.
+
+    Returns
+    -------
+    xarray.Dataset
+        The validated Recording.
+    """
+    temp = get.get("temp")
+    return schema.make_recording(
+        get["acc"],
+        get.get("gyr"),
+        fs,
+        acc_units=units["acc"],
+        gyr_units=units.get("gyr"),
+        mag=get.get("mag"),
+        mag_units=units.get("mag"),
+        temp=None if temp is None else temp.reshape(-1),
+        temp_units=units.get("temp"),
+        **options,
+    )

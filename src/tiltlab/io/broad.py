@@ -7,8 +7,8 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
-from .. import schema
-from ._common import PathLike, ReadError
+
+from ._common import PathLike, ReadError, no_file, sensor_recording
 
 
 _BROAD_VARS = ("imu_acc", "imu_gyr", "imu_mag", "opt_quat", "opt_pos", "movement")
@@ -23,16 +23,8 @@ _WIDTH = {
 }
 
 
-def _existing_file(path: Path) -> None:
-    """Refuse a missing path, or a directory given where a file is expected."""
-    if path.is_dir():
-        raise ReadError(f"{path}: is a directory, not a file")
-    if not path.is_file():
-        raise ReadError(f"{path}: no such file")
-
-
 def _check_layout(path: Path, data: dict[str, np.ndarray]) -> int:
-    """The number of samples; a transposed or mis-shaped variable is refused by name."""
+    """Count the samples, refusing a transposed or mis-shaped variable by name."""
     transposed = [
         k
         for k, w in _WIDTH.items()
@@ -66,8 +58,10 @@ def _check_layout(path: Path, data: dict[str, np.ndarray]) -> int:
 
 
 def _movement_mask(path: Path, movement: np.ndarray) -> np.ndarray:
-    """BROAD's ``movement`` flags as booleans; anything but 0/1 (NaN included) is an
-    error naming the rows, never a silent ``True``.
+    """Read BROAD's ``movement`` flags as booleans.
+
+    Anything but 0/1 (NaN included) is an error naming the rows, never a silent
+    ``True``.
     """
     m = np.asarray(movement).reshape(-1)
     if m.dtype == bool:
@@ -145,6 +139,20 @@ def read_broad(path: PathLike, *, check_units: bool = True, **attrs) -> xr.Datas
     and ``opt_pos`` the optical position (m). ``check_units=False`` skips the unit
     plausibility check (:func:`tiltlab.schema.make_recording`), as for every reader.
 
+    Parameters
+    ----------
+    path : path-like
+        The trial file.
+    check_units : bool, optional
+        False accepts the published units unchecked (they pass the check).
+    **attrs
+        Attributes to add to the Recording (provenance, e.g. ``subject="S01"``).
+
+    Returns
+    -------
+    xarray.Dataset
+        The Recording, with ``q_ref``, ``movement`` and ``opt_pos``.
+
     Raises
     ------
     ReadError
@@ -160,7 +168,8 @@ def read_broad(path: PathLike, *, check_units: bool = True, **attrs) -> xr.Datas
        doi:10.3390/data6070072
     """
     path = Path(path)
-    _existing_file(path)
+    if not path.is_file():
+        raise ReadError(no_file(path))
     suffix = path.suffix.lower()
     if suffix in (".hdf5", ".h5"):
         data, fs, info = _read_broad_hdf5(path)
@@ -175,14 +184,10 @@ def read_broad(path: PathLike, *, check_units: bool = True, **attrs) -> xr.Datas
     q = data["opt_quat"].astype(float)
     # the optical reference has NaN where tracking was lost; keep NaN, validate with allow_nan
     trial = path.stem
-    return schema.make_recording(
-        data["imu_acc"],
-        data["imu_gyr"],
+    return sensor_recording(
+        {"acc": data["imu_acc"], "gyr": data["imu_gyr"], "mag": data["imu_mag"]},
         fs,
-        acc_units="m/s^2",
-        gyr_units="rad/s",
-        mag=data["imu_mag"],
-        mag_units="uT",
+        {"acc": "m/s^2", "gyr": "rad/s", "mag": "uT"},
         q_ref=q,
         check_units=check_units,
         extra={

@@ -1,7 +1,7 @@
-"""Clocks of real files: time units, epoch times, sampling-rate estimates, and putting
-samples on a uniform grid (exactly, or by linear interpolation).
+"""Handle the clocks of real files: time units, epoch times, rate estimates and grids.
 
-Used by :func:`tiltlab.io.read_csv` and :func:`tiltlab.io.read_multi`. A logger's time
+Samples are put on a uniform grid exactly, or by linear interpolation. Used by
+:func:`tiltlab.io.read_csv` and :func:`tiltlab.io.read_multi`. A logger's time
 column is rarely a perfect ``k / fs`` grid: boards deliver samples in bursts, crystals
 drift by a percent, and loggers drop samples. Two policies exist:
 
@@ -54,7 +54,7 @@ CLOCK_POLICIES: tuple[str, ...] = ("grid", "resample")
 
 #: What to do with samples missing from the time column: refuse the file, or put NaN
 #: rows in their place.
-GAP_POLICIES: tuple[str, ...] = ("raise", "nan")
+READ_GAP_POLICIES: tuple[str, ...] = ("raise", "nan")
 
 #: Default longest step (in sample periods) that ``clock="resample"`` interpolates
 #: across; a longer one is a real gap.
@@ -73,8 +73,21 @@ _EPOCH_RANGE = (10 * 365.25 * 86400, 130 * 365.25 * 86400)
 
 
 def option_hint(key: str, value: Any, style: str) -> str:
-    """An option as the user writes it: ``"clock": "resample"`` in a mapping (JSON),
-    ``clock='resample'`` as a keyword.
+    """Write an option as the user writes it, for messages.
+
+    Parameters
+    ----------
+    key : str
+        The option's name.
+    value : object
+        Its value.
+    style : {"mapping", "python"}
+        How the options were given.
+
+    Returns
+    -------
+    str
+        ``"clock": "resample"`` in a mapping (JSON), ``clock='resample'`` as a keyword.
     """
     if style == "mapping":
         return f"{json.dumps(key)}: {json.dumps(value)}"
@@ -82,7 +95,25 @@ def option_hint(key: str, value: Any, style: str) -> str:
 
 
 def time_factor(time_units: str, where: str = "") -> float:
-    """Factor from a time unit (``"s"``, ``"ms"``, ``"us"``, ``"ns"``) to seconds."""
+    """Convert a time unit (``"s"``, ``"ms"``, ``"us"``, ``"ns"``) to its factor to seconds.
+
+    Parameters
+    ----------
+    time_units : str
+        The unit, or one of its aliases.
+    where : str, optional
+        Prefix naming the mapping in messages.
+
+    Returns
+    -------
+    float
+        Seconds per unit.
+
+    Raises
+    ------
+    ValueError
+        If the unit is not known.
+    """
     key = _TIME_ALIASES.get(str(time_units).strip())
     if key is None:
         raise ValueError(
@@ -93,7 +124,18 @@ def time_factor(time_units: str, where: str = "") -> float:
 
 
 def unit_name(scale: float) -> str:
-    """The name of the time unit with factor ``scale`` to seconds, for messages."""
+    """Name the time unit whose factor to seconds is ``scale``, for messages.
+
+    Parameters
+    ----------
+    scale : float
+        Factor from the time column to seconds.
+
+    Returns
+    -------
+    str
+        ``"s"``, ``"ms"``, ``"us"`` or ``"ns"``, else ``"× <scale> s"``.
+    """
     return next(
         (u for u, f in TIME_UNITS.items() if np.isclose(f, scale)), f"× {scale:g} s"
     )
@@ -105,8 +147,25 @@ def unit_hint(
     scale: float | None = None,
     style: str = "python",
 ) -> str:
-    """Which time unit (other than the one in use, factor ``scale`` to seconds) would
-    make ``raw_step`` (in the column's numbers) a plausible sampling interval.
+    """Suggest the time unit that would make ``raw_step`` a plausible sampling interval.
+
+    Units other than the one in use (factor ``scale`` to seconds) are tried in turn.
+
+    Parameters
+    ----------
+    raw_step : float
+        The median step of the time column, in the column's numbers.
+    fs_range : (float, float) or None
+        Plausible rates (Hz); None uses :data:`FS_RANGE`.
+    scale : float, optional
+        The factor in use, which is not suggested.
+    style : {"python", "mapping"}, optional
+        How the options were given, to write the fix.
+
+    Returns
+    -------
+    str
+        ``"; the time column looks like …"``, or ``""`` if no unit fits.
     """
     lo, hi = fs_range or FS_RANGE
     for unit, factor in TIME_UNITS.items():
@@ -124,7 +183,7 @@ def unit_hint(
 def to_seconds(
     raw: np.ndarray, time_units: str | float, where: str = ""
 ) -> tuple[np.ndarray, np.datetime64 | None]:
-    """A time column as seconds.
+    """Convert a time column to seconds, relative to its first sample when absolute.
 
     Parameters
     ----------
@@ -193,14 +252,40 @@ def to_seconds(
 
 
 def iso_utc(origin: np.datetime64) -> str:
-    """An ISO-8601 UTC string for an absolute time."""
+    """Format an absolute time as an ISO-8601 UTC string.
+
+    Parameters
+    ----------
+    origin : numpy.datetime64
+        The time (UTC).
+
+    Returns
+    -------
+    str
+        E.g. ``"2024-05-01T12:00:00+00:00"``.
+    """
     import pandas as pd
 
     return pd.Timestamp(origin).tz_localize("UTC").isoformat()
 
 
 def check_increasing(time: np.ndarray, column: str, where: str) -> None:
-    """Refuse non-finite or non-increasing sample times, naming the data row."""
+    """Refuse non-finite or non-increasing sample times, naming the data row.
+
+    Parameters
+    ----------
+    time : numpy.ndarray, shape (N,)
+        Sample times (s).
+    column : str
+        The time column's name.
+    where : str
+        Prefix (the file) for messages.
+
+    Raises
+    ------
+    tiltlab.schema.RecordingError
+        If a time is not finite or does not increase.
+    """
     if not np.all(np.isfinite(time)):
         i = int(np.argmax(~np.isfinite(time)))
         raise schema.RecordingError(
@@ -216,17 +301,39 @@ def check_increasing(time: np.ndarray, column: str, where: str) -> None:
 
 
 def gap_steps(time: np.ndarray, fs: float, max_gap: float) -> np.ndarray:
-    """Indices ``i`` of the steps ``time[i] → time[i+1]`` longer than ``max_gap / fs``."""
+    """Find the steps ``time[i] → time[i+1]`` longer than ``max_gap / fs``.
+
+    Parameters
+    ----------
+    time : numpy.ndarray, shape (N,)
+        Sample times (s).
+    fs : float
+        The clock's rate (Hz).
+    max_gap : float
+        Longest ordinary step, in sample periods.
+
+    Returns
+    -------
+    numpy.ndarray of int
+        The indices ``i`` of the long steps.
+    """
     return np.flatnonzero(np.diff(time) > max_gap / fs)
 
 
 def estimate_rate(time: np.ndarray, max_gap: float = MAX_GAP) -> tuple[float, int]:
-    """A robust sampling rate of an irregular clock: (samples − 1) / duration, leaving
-    out the real gaps (steps longer than ``max_gap`` periods) and the samples missing
-    in them.
+    """Estimate a robust sampling rate of an irregular clock.
 
-    The mean rate, unlike 1 / median step, is right for bursty clocks (many short steps
-    and a few long ones) and for clocks that alternate between two step lengths.
+    The rate is (samples − 1) / duration, leaving out the real gaps (steps longer than
+    ``max_gap`` periods) and the samples missing in them. The mean rate, unlike
+    1 / median step, is right for bursty clocks (many short steps and a few long ones)
+    and for clocks that alternate between two step lengths.
+
+    Parameters
+    ----------
+    time : numpy.ndarray, shape (N,)
+        Sample times (s), strictly increasing.
+    max_gap : float, optional
+        Longest ordinary step, in sample periods (default :data:`MAX_GAP`).
 
     Returns
     -------
@@ -269,7 +376,30 @@ def raise_gaps(
     where: str,
     style: str,
 ) -> None:
-    """The error for real gaps in a clock read with ``clock="resample"``."""
+    """Raise the error for real gaps in a clock read with ``clock="resample"``.
+
+    Parameters
+    ----------
+    time : numpy.ndarray, shape (N,)
+        Sample times (s).
+    idx : numpy.ndarray of int
+        The gap steps (:func:`gap_steps`).
+    fs : float
+        The clock's rate (Hz).
+    max_gap : float
+        Longest ordinary step, in sample periods.
+    column : str
+        The time column's name.
+    where : str
+        Prefix (the file) for the message.
+    style : {"python", "mapping"}
+        How the options were given, to write the fix.
+
+    Raises
+    ------
+    tiltlab.schema.RecordingError
+        Always, listing the gaps and the options that read the file.
+    """
     raise schema.RecordingError(
         f"{where}time column {column!r} has steps longer than max_gap = {max_gap:g} "
         f"sample periods ({max_gap / fs:.3g} s at {fs:.6g} Hz), which are not "
@@ -289,8 +419,9 @@ def check_missing_fraction(
     where: str,
     gap_idx: np.ndarray | None = None,
 ) -> None:
-    """Refuse a regridding (``gaps="nan"``) that would leave more than
-    :data:`MAX_MISSING_FRACTION` of the ``n_grid`` samples missing.
+    """Refuse a regridding (``gaps="nan"``) that would leave the grid mostly missing.
+
+    More than :data:`MAX_MISSING_FRACTION` of the ``n_grid`` samples missing is refused.
 
     Parameters
     ----------
@@ -327,7 +458,20 @@ def check_missing_fraction(
 
 
 def uniform_grid(start: float, stop: float, fs: float) -> np.ndarray:
-    """``start + k / fs`` for every k with the time inside ``[start, stop]``."""
+    """Build the grid ``start + k / fs`` for every k with the time inside ``[start, stop]``.
+
+    Parameters
+    ----------
+    start, stop : float
+        The interval (s).
+    fs : float
+        Grid rate (Hz).
+
+    Returns
+    -------
+    numpy.ndarray, shape (M,)
+        The grid times (s); ``grid[0] == start``.
+    """
     n = int(np.floor((stop - start) * fs * (1 + 1e-12) + 1e-9)) + 1
     return start + np.arange(max(n, 0)) / fs
 
@@ -340,15 +484,33 @@ def interpolate(
     *,
     quaternion: bool = False,
 ) -> np.ndarray:
-    """Linear interpolation of samples at ``time`` onto ``grid`` (inside the samples'
-    span), NaN inside the steps listed in ``gap_idx``.
+    """Interpolate samples at ``time`` linearly onto ``grid``, NaN inside gaps.
 
-    Each grid value is the straight line between the two samples around it. Linear
-    interpolation never overshoots and keeps a still sensor still, but it is a mild
+    Each grid value (inside the samples' span) is the straight line between the two
+    samples around it; grid times strictly inside the steps listed in ``gap_idx`` are NaN.
+    Linear interpolation never overshoots and keeps a still sensor still, but it is a mild
     low-pass filter: a sine at frequency f sampled every T loses up to
     ``1 - sinc²(f T)`` of its amplitude between samples, and nothing is done against
     aliasing when the grid is coarser than the samples. ``quaternion=True`` keeps the
     quaternions in one hemisphere before interpolating and normalises the result.
+
+    Parameters
+    ----------
+    time : numpy.ndarray, shape (N,)
+        Sample times (s), strictly increasing.
+    values : numpy.ndarray, shape (N, ...)
+        The samples.
+    grid : numpy.ndarray, shape (M,)
+        Target times (s), inside ``[time[0], time[-1]]``.
+    gap_idx : numpy.ndarray of int, optional
+        Steps that are real gaps (:func:`gap_steps`).
+    quaternion : bool, optional
+        Whether ``values`` are unit quaternions (N, 4).
+
+    Returns
+    -------
+    numpy.ndarray, shape (M, ...)
+        The values on the grid.
     """
     v = np.asarray(values, dtype=float)
     v2 = v.reshape(v.shape[0], -1)
@@ -374,7 +536,22 @@ def interpolate(
 
 
 def describe_resampling(time: np.ndarray, n_out: int, fs: float) -> str:
-    """A sentence for ``attrs['resampled']``."""
+    """Describe a resampling in one sentence, for ``attrs['resampled']``.
+
+    Parameters
+    ----------
+    time : numpy.ndarray, shape (N,)
+        The original sample times (s).
+    n_out : int
+        Samples on the grid.
+    fs : float
+        Grid rate (Hz).
+
+    Returns
+    -------
+    str
+        Original sample count, median and longest step, and the grid.
+    """
     steps = np.diff(time)
     return (
         f"{time.size} samples with irregular steps (median {np.median(steps) * 1e3:.4g} "
@@ -384,7 +561,22 @@ def describe_resampling(time: np.ndarray, n_out: int, fs: float) -> str:
 
 
 def warn_if_downsampled(fs: float, fs_source: float, what: str) -> None:
-    """Linear interpolation onto a coarser grid does not remove what it cannot hold."""
+    """Warn when interpolating onto a coarser grid, which does not remove aliasing.
+
+    Parameters
+    ----------
+    fs : float
+        Grid rate (Hz).
+    fs_source : float
+        The samples' own rate (Hz).
+    what : str
+        The file (and stream) named in the warning.
+
+    Warns
+    -----
+    tiltlab.quality.QualityWarning
+        If ``fs`` is below 90 % of ``fs_source``.
+    """
     if fs < 0.9 * fs_source:
         import warnings
 
@@ -407,13 +599,39 @@ def place_on_grid(
     gaps: str,
     style: str,
 ) -> tuple[np.ndarray, dict[str, np.ndarray], int]:
-    """``clock="grid"``: find samples missing from a time column (steps of about k/fs,
-    k ≥ 2), refuse them (``gaps="raise"``) or insert NaN rows in their place
-    (``"nan"``); return the time, the columns and the number of samples inserted.
+    """Place the samples of a ``clock="grid"`` time column on the ``k / fs`` grid.
 
-    A clock that is not on a ``k / fs`` grid (jitter, drift) is refused with a hint to
-    read it with ``clock="resample"``. With ``"nan"``, a grid that would be more than
+    Samples missing from the time column (steps of about k/fs, k ≥ 2) are refused
+    (``gaps="raise"``) or replaced by NaN rows (``"nan"``). A clock that is not on a
+    ``k / fs`` grid (jitter, drift) is refused with a hint to read it with
+    ``clock="resample"``. With ``"nan"``, a grid that would be more than
     :data:`MAX_MISSING_FRACTION` missing is refused (:func:`check_missing_fraction`).
+
+    Parameters
+    ----------
+    time : numpy.ndarray, shape (N,)
+        Sample times (s), strictly increasing.
+    get : dict
+        Variable → samples (N, ...).
+    fs : float
+        Sampling rate (Hz).
+    column : str
+        The time column's name.
+    where : str
+        Prefix (the file) for messages.
+    gaps : {"raise", "nan"}
+        What to do with missing samples.
+    style : {"python", "mapping"}
+        How the options were given, to write the fix.
+
+    Returns
+    -------
+    time : numpy.ndarray
+        The grid times (s).
+    values : dict
+        Variable → samples on the grid (NaN rows where samples are missing).
+    n_missing : int
+        Number of rows inserted.
     """
     segs = _validate.segments(time, fs)
     if len(segs) <= 1:
@@ -456,5 +674,18 @@ def place_on_grid(
 
 
 def source_name(path: Path, variable: str | None = None) -> str:
-    """A file name (and variable) for attrs."""
+    """Name a file (and variable) for attributes.
+
+    Parameters
+    ----------
+    path : Path
+        The file.
+    variable : str, optional
+        The variable read from it.
+
+    Returns
+    -------
+    str
+        ``"name.mat:variable"`` or ``"name.csv"``.
+    """
     return path.name + (f":{variable}" if variable else "")

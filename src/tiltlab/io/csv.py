@@ -1,4 +1,4 @@
-"""A generic CSV with a column/unit mapping (:func:`read_csv`)."""
+"""Read a generic CSV through a column/unit mapping (:func:`read_csv`)."""
 
 from __future__ import annotations
 
@@ -11,35 +11,38 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
-from .. import _validate, schema
+from .. import _validate
 from .. import quality as _quality
 import tiltlab.io.clock as _clock
 from ._common import (
     PathLike,
     ReadError,
     _missing_columns_message,
+    no_file,
     read_table_or_fail,
+    sensor_recording,
 )
-from .clock import CLOCK_POLICIES, GAP_POLICIES, MAX_GAP, TIME_UNITS
-from .mapping import FS_RANGE, check_mapping, load_mapping
+from .clock import CLOCK_POLICIES, MAX_GAP, READ_GAP_POLICIES, TIME_UNITS
+from .mapping import FS_RANGE, MAPPING_KEYS, CsvMapping, check_mapping, load_mapping
 
 __all__ = [
     "read_csv",
     "read_csv_mapping",
+    "CsvMapping",
     "TIME_UNITS",
     "FS_RANGE",
-    "GAP_POLICIES",
+    "READ_GAP_POLICIES",
     "CLOCK_POLICIES",
     "MAX_GAP",
 ]
 
 
-def read_csv_mapping(mapping: Mapping[str, Any] | PathLike) -> dict[str, Any]:
+def read_csv_mapping(mapping: Mapping[str, Any] | PathLike | CsvMapping) -> CsvMapping:
     """Load and check a column/unit mapping for :func:`read_csv`.
 
     Parameters
     ----------
-    mapping : dict or path-like
+    mapping : dict, CsvMapping or path-like
         The mapping itself, or the path of a JSON file holding it::
 
             {
@@ -82,13 +85,14 @@ def read_csv_mapping(mapping: Mapping[str, Any] | PathLike) -> dict[str, Any]:
 
     Returns
     -------
-    dict
-        Keys ``columns`` (variable → list of names), ``units`` (canonical spellings),
-        ``time_column``, ``time_scale`` (factor to seconds; None for date-times),
-        ``time_units`` (the unit's name, or None for another factor), ``range``,
-        ``scale``, ``fs`` (float or None), ``fs_range``, ``gaps``, ``clock``,
-        ``max_gap``, ``check_units``, ``axes``, ``preset``, ``axis_labels``, ``attrs``
-        and ``read_csv`` (options for :func:`pandas.read_csv`).
+    CsvMapping
+        The checked mapping, a frozen record whose fields are ``columns`` (variable
+        → list of names), ``units`` (canonical spellings), ``time_column``,
+        ``time_scale`` (factor to seconds; None for date-times), ``time_units`` (the
+        unit's name, or None for another factor), ``range``, ``scale``, ``fs`` (float
+        or None), ``fs_range``, ``gaps``, ``clock``, ``max_gap``, ``check_units``,
+        ``axes``, ``preset``, ``axis_labels``, ``attrs`` and ``read_csv`` (options for
+        :func:`pandas.read_csv`); ``m["units"]`` reads a field too.
 
     Raises
     ------
@@ -103,24 +107,25 @@ def read_csv_mapping(mapping: Mapping[str, Any] | PathLike) -> dict[str, Any]:
     >>> from tiltlab import io
     >>> m = io.read_csv_mapping({"columns": {"acc": ["ax", "ay", "az"]},
     ...                          "units": {"acc": "g"}, "fs": 50})
-    >>> m["columns"]["acc"], m["clock"], m["gaps"]
+    >>> m.columns["acc"], m.clock, m.gaps
     (['ax', 'ay', 'az'], 'grid', 'raise')
     """
-    raw, where = load_mapping(mapping)
-    return check_mapping(raw, where)
+    return CsvMapping.load(mapping)
 
 
 def _flat(name: Any) -> str:
-    """A column name, the levels of a multi-row header joined with ``/``."""
+    """Name a column, joining the levels of a multi-row header with ``/``."""
     if isinstance(name, tuple):
         return "/".join(str(level) for level in name)
     return str(name)
 
 
 def _numeric(values: pd.Series, name: str, path: Path, raw_text=None) -> np.ndarray:
-    """A column as numbers, refusing text, missing-value markers and empty fields
-    with the data row. ``raw_text(row)``, if given, returns the field as written in
-    the file (pandas has already turned markers such as ``NaN`` or ``NA`` into NaN).
+    """Convert a column to numbers, refusing text, missing values and empty fields.
+
+    The error names the data row. ``raw_text(row)``, if given, returns the field as
+    written in the file (pandas has already turned markers such as ``NaN`` or ``NA``
+    into NaN).
     """
     num = pd.to_numeric(values, errors="coerce")
     bad = num.isna().to_numpy()
@@ -156,8 +161,10 @@ _NA_MARKERS = frozenset(
 
 
 def _raw_field(path: Path, kwargs: Mapping[str, Any], column: str):
-    """A function ``row -> str``: the field of ``column`` as written in the file (read
-    again without missing-value conversion; used for error messages only).
+    """Make a function ``row -> str`` giving the field of ``column`` as written.
+
+    The file is read again without missing-value conversion; used for error messages
+    only.
     """
 
     def get(row: int):
@@ -188,14 +195,37 @@ def read_frame(
     text: Sequence[str] = (),
     **read_kwargs,
 ) -> dict[str, np.ndarray]:
-    """Read the ``wanted`` columns of a CSV: numbers (integers kept as integers), or
-    the raw values for the columns in ``text``. A header of several rows is flattened
-    (levels joined with ``/``).
+    """Read the ``wanted`` columns of a CSV as numbers, or as text for ``text``.
+
+    Integers are kept as integers. A header of several rows is flattened (levels joined
+    with ``/``).
+
+    Parameters
+    ----------
+    path : Path
+        CSV file.
+    wanted : sequence of str
+        Columns to read.
+    roles : mapping
+        Column → what it is mapped to, for messages about missing columns.
+    text : sequence of str, optional
+        Columns returned as read (date-time text).
+    **read_kwargs
+        Options for :func:`pandas.read_csv`.
+
+    Returns
+    -------
+    dict
+        Column name → values.
+
+    Raises
+    ------
+    ReadError
+        If the file is missing or unreadable, lacks a column, holds fewer than two
+        samples, or a column is not numeric.
     """
-    if path.is_dir():
-        raise ReadError(f"{path}: is a directory, not a file")
     if not path.is_file():
-        raise ReadError(f"{path}: no such file")
+        raise ReadError(no_file(path))
     header = read_kwargs.get("header", "infer")
     multi = isinstance(header, (list, tuple)) and len(header) > 1
     want = set(wanted)
@@ -235,21 +265,91 @@ def read_frame(
     return out
 
 
-def _merge_arguments(
-    raw: dict[str, Any], explicit: Mapping[str, Any], read_kwargs: dict[str, Any]
-) -> None:
-    """Put keyword arguments given explicitly into the raw mapping (they win)."""
-    for key, value in explicit.items():
-        if value is not None:
-            raw[key] = value
-    for key in ("range", "scale"):  # as in a mapping
-        if key in read_kwargs:
-            raw[key] = read_kwargs.pop(key)
-    nested = read_kwargs.pop("read_csv", None) or {}
+#: Keys of a mapping that :func:`read_csv` takes as keywords in ``**options``.
+_MAPPING_OPTIONS = frozenset(MAPPING_KEYS) - {"columns", "units", "read_csv"}
+
+
+def _raw_mapping(
+    columns: Any,
+    units: Mapping[str, str] | None,
+    mapping: Mapping[str, Any] | PathLike | CsvMapping | None,
+    explicit: Mapping[str, Any],
+    options: dict[str, Any],
+) -> tuple[dict[str, Any], str]:
+    """Merge the keywords of a :func:`read_csv` call into its raw mapping (they win)."""
+    raw: dict[str, Any] = {}
+    where = ""
+    if mapping is not None:
+        raw, where = load_mapping(mapping)
+    elif columns is not None and (
+        isinstance(columns, (str, os.PathLike, CsvMapping))
+        or (isinstance(columns, Mapping) and "columns" in columns)
+    ):
+        # read_csv(path, "mapping.json") or read_csv(path, {"columns": ..., "units": ...})
+        raw, where = load_mapping(columns)
+        columns = None
+    if columns is not None:
+        raw["columns"] = columns
+    if units is not None:
+        raw["units"] = {**(raw.get("units") or {}), **units}
+    given = {k: options.pop(k) for k in list(options) if k in _MAPPING_OPTIONS}
+    given.update(explicit)
+    if given.get("time_scale") is not None or given.get("time_units") is not None:
+        for k in ("time_scale", "time_units"):
+            raw.pop(k, None)
+        if isinstance(raw.get("units"), Mapping):
+            raw["units"] = {k: v for k, v in raw["units"].items() if k != "time"}
+    if "fs_range" in given:  # None disables the check
+        raw["fs_range"] = given.pop("fs_range")
+    attrs = given.pop("attrs", None)
+    if attrs:
+        raw["attrs"] = {**(raw.get("attrs") or {}), **attrs}
+    raw.update({k: v for k, v in given.items() if v is not None})
+    nested = options.pop("read_csv", None) or {}
     if not isinstance(nested, Mapping):
         raise ValueError("read_csv must be a mapping of pandas.read_csv options")
-    if read_kwargs or nested:
-        raw["read_csv"] = {**(raw.get("read_csv") or {}), **nested, **read_kwargs}
+    if options or nested:
+        raw["read_csv"] = {**(raw.get("read_csv") or {}), **nested, **options}
+    return raw, where
+
+
+def read_columns(
+    path: Path,
+    columns: Mapping[str, Sequence[str]],
+    time_column: str | None,
+    time_units: str | None,
+    read_options: Mapping[str, Any],
+) -> dict[str, np.ndarray]:
+    """Read the mapped columns and the time column of a CSV (:func:`read_frame`).
+
+    Parameters
+    ----------
+    path : Path
+        CSV file.
+    columns : mapping
+        Variable → column names.
+    time_column : str or None
+        Column of sample times (read as text for date-times).
+    time_units : str or None
+        The time unit's name; ``"datetime"`` keeps the time column as text.
+    read_options : mapping
+        Options for :func:`pandas.read_csv`.
+
+    Returns
+    -------
+    dict
+        Column name → values.
+    """
+    roles = {c: var for var, names in columns.items() for c in names}
+    if time_column:
+        roles.setdefault(time_column, "time_column")
+    return read_frame(
+        path,
+        list(roles),
+        roles,
+        text=[time_column] if time_units == _clock.DATETIME else (),
+        **read_options,
+    )
 
 
 def read_csv(
@@ -257,23 +357,15 @@ def read_csv(
     columns: Mapping[str, Sequence[str] | str] | None = None,
     units: Mapping[str, str] | None = None,
     *,
-    mapping: Mapping[str, Any] | PathLike | None = None,
+    mapping: Mapping[str, Any] | PathLike | CsvMapping | None = None,
     fs: float | None = None,
     time_column: str | None = None,
-    time_scale: float | None = None,
     time_units: str | None = None,
-    fs_range: tuple[float, float] | None = FS_RANGE,
     clock: str | None = None,
-    max_gap: float | None = None,
     gaps: str | None = None,
-    check_units: bool | None = None,
-    axes: Sequence[str] | Mapping[str, Sequence[str]] | None = None,
-    preset: str | None = None,
-    axis_labels: Sequence[str] | None = None,
-    attrs: Mapping[str, Any] | None = None,
-    **read_kwargs,
+    **options: Any,
 ) -> xr.Dataset:
-    """Read any CSV with a column/unit mapping.
+    r"""Read any CSV with a column/unit mapping.
 
     Parameters
     ----------
@@ -290,14 +382,12 @@ def read_csv(
         Variable → unit string, e.g. ``{"acc": "m/s^2", "gyr": "rad/s"}``; required for
         every physical variable in ``columns`` (no unit is assumed). ``"time"`` may give
         the unit of the time column (as ``time_units``).
-    mapping : dict or path-like, optional
-        A whole mapping (:func:`read_csv_mapping`), or the path of a JSON file holding
-        one. Arguments given explicitly override it (``units`` and ``attrs`` are
-        merged). Its ``range`` (variable → the sensor's full scale) and ``scale``
-        (variable → factor from the column's numbers to its ``units``, e.g.
-        ``{"acc": 0.001}`` for mg; kept in ``attrs['csv_scale']``) may also be given as
-        keywords. When the options come from a mapping, error messages name the fix as
-        a JSON key (``"clock": "resample"``), else as a keyword (``clock='resample'``).
+    mapping : dict, CsvMapping or path-like, optional
+        A whole mapping (:class:`CsvMapping`, :func:`read_csv_mapping`), a dict, or
+        the path of a JSON file holding one. Arguments given explicitly override it
+        (``units`` and ``attrs`` are merged). When the options come from a mapping,
+        error messages name the fix as a JSON key (``"clock": "resample"``), else as a
+        keyword (``clock='resample'``).
     fs : float, optional
         Sampling rate (Hz). If omitted, ``time_column`` is required and ``fs`` is
         estimated (recorded in ``attrs['fs_source']``): with ``clock="grid"`` as
@@ -305,18 +395,12 @@ def read_csv(
         out the real gaps; to 7 significant digits.
     time_column : str, optional
         Column with sample times.
-    time_scale : float, optional
-        Factor converting the time column to seconds (e.g. ``1e-3`` for ms).
     time_units : {"s", "ms", "us", "ns", "datetime"}, optional
         Unit of the time column; an alternative to ``time_scale``. Default seconds.
         ``"datetime"`` parses date-time text (:func:`pandas.to_datetime`; read as UTC
         when no zone is written). Epoch times (numbers whose first sample, in the given
         unit, falls between 1980 and 2100) and date-times are made relative to the first
         sample, whose absolute time is kept in ``attrs['time_origin']`` (ISO 8601, UTC).
-    fs_range : (float, float) or None
-        Plausible sampling rates (Hz). A rate outside it — estimated, or given and
-        contradicted by the time column — is an error that suggests the time unit that
-        would fit. ``None`` disables the check.
     clock : {"grid", "resample"}, optional
         ``"grid"`` (default): the samples must sit on a ``k / fs`` grid, and steps of
         several periods are dropped samples, handled by ``gaps``. ``"resample"``: for
@@ -330,10 +414,6 @@ def read_csv(
         f T = 0.1) and does not remove aliasing: when ``fs`` is much lower than the
         clock's rate a :class:`~tiltlab.quality.QualityWarning` says to low-pass
         filter first.
-    max_gap : float, optional
-        With ``clock="resample"``: the longest step, in sample periods of the time
-        column's own rate, that is interpolated across (default 5). A longer step is a
-        real gap, handled by ``gaps``.
     gaps : {"raise", "nan"}, optional
         What to do with samples missing from the time column (a logger that dropped
         samples: steps longer than 1.5 periods on a grid clock, longer than
@@ -344,18 +424,39 @@ def read_csv(
         (:data:`tiltlab.io.clock.MAX_MISSING_FRACTION`, 50 %) is refused with the
         longest time jump and its data rows named: such a grid comes from a
         corrupted timestamp or a reset clock, not from dropped samples.
-    check_units : bool, optional
-        Passed to :func:`tiltlab.schema.make_recording` (default True). A
-        :class:`~tiltlab.quality.UnitCheckError` names the switch as the options were
-        given (``"check_units": false`` in a mapping, ``check_units=False`` here).
-    axes, preset, axis_labels : optional
-        Device axes and sign conventions, passed to
-        :func:`tiltlab.schema.make_recording` (e.g. ``axes={"acc": ["-x", "-y", "-z"]}``
-        for a logger that reports gravity instead of specific force).
-    attrs : mapping, optional
-        Extra dataset attributes (provenance).
-    **read_kwargs
-        Passed to :func:`pandas.read_csv` (e.g. ``sep=';'``, ``header=[0, 1]``).
+    **options
+        Any other key of a mapping (:func:`read_csv_mapping`), as a keyword; they
+        override the mapping's:
+
+        time_scale : float, optional
+            Factor converting the time column to seconds (e.g. ``1e-3`` for ms).
+        fs_range : (float, float) or None
+            Plausible sampling rates (Hz). A rate outside it — estimated, or given and
+            contradicted by the time column — is an error that suggests the time unit that
+            would fit. ``None`` disables the check.
+        max_gap : float, optional
+            With ``clock="resample"``: the longest step, in sample periods of the time
+            column's own rate, that is interpolated across (default 5). A longer step is a
+            real gap, handled by ``gaps``.
+        range : mapping, optional
+            Variable → the sensor's full scale (``r`` for ±r, or ``[low, high]``; acc,
+            gyr, mag), used to find clipped samples.
+        scale : mapping, optional
+            Variable → factor from the column's numbers to its ``units``, e.g.
+            ``{"acc": 0.001}`` for mg; kept in ``attrs['csv_scale']``.
+        check_units : bool, optional
+            Passed to :func:`tiltlab.schema.make_recording` (default True). A
+            :class:`~tiltlab.quality.UnitCheckError` names the switch as the options were
+            given (``"check_units": false`` in a mapping, ``check_units=False`` here).
+        axes, preset, axis_labels : optional
+            Device axes and sign conventions, passed to
+            :func:`tiltlab.schema.make_recording` (e.g. ``axes={"acc": ["-x", "-y", "-z"]}``
+            for a logger that reports gravity instead of specific force).
+        attrs : mapping, optional
+            Extra dataset attributes (provenance).
+
+        Any other keyword is passed to :func:`pandas.read_csv` (e.g. ``sep=';'``,
+        ``header=[0, 1]``), as are the options under ``read_csv={...}``.
 
     Returns
     -------
@@ -384,74 +485,37 @@ def read_csv(
     >>> t = np.cumsum(np.r_[0, np.full(199, 0.01) * (1 + 0.2 * np.sin(np.arange(199)))])
     >>> rows = ["t,ax,ay,az"] + [f"{x:.6f},0,0,1" for x in t]
     >>> p = pathlib.Path(tempfile.mkdtemp()) / "log.csv"
-    >>> _ = p.write_text("\\n".join(rows))
+    >>> _ = p.write_text("\n".join(rows))
     >>> rec = io.read_csv(p, {"acc": ["ax", "ay", "az"]}, {"acc": "g"},
     ...                   time_column="t", clock="resample", fs=100)
     >>> rec.attrs["fs"], bool(np.allclose(np.diff(rec.time), 0.01))
     (100.0, True)
     """
     path = Path(path)
-    raw: dict[str, Any] = {}
-    where = ""
-    if mapping is not None:
-        raw, where = load_mapping(mapping)
-    elif columns is not None and (
-        isinstance(columns, (str, os.PathLike))
-        or (isinstance(columns, Mapping) and "columns" in columns)
-    ):
-        # read_csv(path, "mapping.json") or read_csv(path, {"columns": ..., "units": ...})
-        raw, where = load_mapping(columns)
-        columns = None
-    style = "mapping" if where else "python"
-    if columns is not None:
-        raw["columns"] = columns
-    if units is not None:
-        raw["units"] = {**(raw.get("units") or {}), **units}
-    if time_scale is not None or time_units is not None:
-        for k in ("time_scale", "time_units"):
-            raw.pop(k, None)
-        if isinstance(raw.get("units"), Mapping):
-            raw["units"] = {k: v for k, v in raw["units"].items() if k != "time"}
-        raw["time_scale"], raw["time_units"] = time_scale, time_units
-    if fs_range != FS_RANGE or "fs_range" not in raw:
-        raw["fs_range"] = fs_range
-    if attrs:
-        raw["attrs"] = {**(raw.get("attrs") or {}), **attrs}
     explicit = {
         "fs": fs,
         "time_column": time_column,
+        "time_units": time_units,
         "clock": clock,
-        "max_gap": max_gap,
         "gaps": gaps,
-        "check_units": check_units,
-        "axes": axes,
-        "preset": preset,
-        "axis_labels": axis_labels,
     }
-    _merge_arguments(raw, explicit, read_kwargs)
+    raw, where = _raw_mapping(columns, units, mapping, explicit, dict(options))
+    style = "mapping" if where else "python"
     m = check_mapping(raw, where)
-    cols, tcol = m["columns"], m["time_column"]
-    roles = {c: var for var, names in cols.items() for c in names}
-    if tcol:
-        roles.setdefault(tcol, "time_column")
-    data = read_frame(
-        path,
-        list(roles),
-        roles,
-        text=[tcol] if m["time_units"] == _clock.DATETIME else (),
-        **m["read_csv"],
-    )
+    data = read_columns(path, m.columns, m.time_column, m.time_units, m.read_csv)
     get = {
-        k: np.column_stack([data[c] for c in v]).astype(float) * m["scale"].get(k, 1.0)
-        for k, v in cols.items()
+        k: np.column_stack([data[c] for c in v]).astype(float) * m.scale.get(k, 1.0)
+        for k, v in m.columns.items()
     }
-    extra_attrs = dict(m["attrs"])
-    if m["scale"]:
-        extra_attrs["csv_scale"] = dict(m["scale"])
-    fs, time, allow_nan = m["fs"], None, False
-    if tcol:
-        time, fs, allow_nan = _apply_clock(data[tcol], get, m, path, extra_attrs, style)
-    lo_hi = m["fs_range"]
+    extra_attrs = dict(m.attrs)
+    if m.scale:
+        extra_attrs["csv_scale"] = dict(m.scale)
+    fs, time, allow_nan = m.fs, None, False
+    if m.time_column:
+        time, fs, allow_nan = _apply_clock(
+            data[m.time_column], get, m, path, extra_attrs, style
+        )
+    lo_hi = m.fs_range
     if lo_hi is not None and not lo_hi[0] <= fs <= lo_hi[1]:
         raise ValueError(
             f"{path}: fs = {fs:g} Hz is outside the plausible range {lo_hi[0]:g}–{lo_hi[1]:g} Hz "
@@ -471,13 +535,13 @@ def read_csv(
 def _apply_clock(
     raw_time: np.ndarray,
     get: dict[str, np.ndarray],
-    m: Mapping[str, Any],
+    m: CsvMapping,
     path: Path,
     extra_attrs: dict[str, Any],
     style: str,
 ) -> tuple[np.ndarray, float, bool]:
-    """Time in seconds on a uniform (or exact) grid; ``get`` is updated in place."""
-    tcol, scale = m["time_column"], m["time_scale"]
+    """Put the samples on a uniform (or exact) grid in seconds; ``get`` is updated."""
+    tcol, scale = m.time_column, m.time_scale
     where = f"{path}: "
     time, origin = _clock.to_seconds(
         raw_time, _clock.DATETIME if scale is None else scale, where
@@ -485,12 +549,12 @@ def _apply_clock(
     if origin is not None:
         extra_attrs["time_origin"] = _clock.iso_utc(origin)
     _clock.check_increasing(time, tcol, where)
-    unit = m["time_units"] or _clock.unit_name(scale)
+    unit = m.time_units or _clock.unit_name(scale)
     raw_scale = 1.0 if scale is None else scale
-    fs, lo_hi = m["fs"], m["fs_range"]
-    resample = m["clock"] == "resample"
+    fs, lo_hi = m.fs, m.fs_range
+    resample = m.clock == "resample"
     if resample:
-        fs_est, n_gaps = _clock.estimate_rate(time, m["max_gap"])
+        fs_est, n_gaps = _clock.estimate_rate(time, m.max_gap)
         how = f"(samples − 1) / duration of column {tcol!r} ({unit})" + (
             f", leaving out {n_gaps} gap{'s' * (n_gaps != 1)}" if n_gaps else ""
         )
@@ -524,7 +588,7 @@ def _apply_clock(
     allow_nan = False
     if not resample:
         time, new, missing = _clock.place_on_grid(
-            time, get, fs, tcol, where, m["gaps"], style
+            time, get, fs, tcol, where, m.gaps, style
         )
         get.update(new)
         if missing:
@@ -536,9 +600,9 @@ def _apply_clock(
                 )
             )
         return time, fs, allow_nan
-    gap_idx = _clock.gap_steps(time, fs_est, m["max_gap"])
-    if gap_idx.size and m["gaps"] == "raise":
-        _clock.raise_gaps(time, gap_idx, fs_est, m["max_gap"], tcol, where, style)
+    gap_idx = _clock.gap_steps(time, fs_est, m.max_gap)
+    if gap_idx.size and m.gaps == "raise":
+        _clock.raise_gaps(time, gap_idx, fs_est, m.max_gap, tcol, where, style)
     grid = _clock.uniform_grid(time[0], time[-1], fs)
     if gap_idx.size:  # grid samples strictly inside the gaps become NaN
         inside = np.searchsorted(
@@ -556,7 +620,7 @@ def _apply_clock(
         n_nan = int(np.isnan(get["acc"][:, 0]).sum())
         extra_attrs["gaps"] = (
             f"{n_nan} grid sample{'s' if n_nan != 1 else ''} in {gap_idx.size} gap"
-            f"{'s' if gap_idx.size != 1 else ''} longer than {m['max_gap']:g} periods "
+            f"{'s' if gap_idx.size != 1 else ''} longer than {m.max_gap:g} periods "
             "filled with NaN; "
             + _validate.describe_gaps(
                 grid, fs, _validate.segments(grid, fs, values=get["acc"])
@@ -568,31 +632,49 @@ def _apply_clock(
 def build_recording(
     get: Mapping[str, np.ndarray],
     fs: float,
-    m: Mapping[str, Any],
+    m: CsvMapping | Mapping[str, Any],
     *,
     time: np.ndarray | None,
     attrs: Mapping[str, Any],
     allow_nan: bool,
     style: str,
 ) -> xr.Dataset:
-    """:func:`tiltlab.schema.make_recording` with a mapping's options; a unit-check
-    error names the switch in the form the options were given.
+    """Build a Recording with a mapping's options (``schema.make_recording``).
+
+    A unit-check error names the switch in the form the options were given.
+
+    Parameters
+    ----------
+    get : mapping
+        Variable → samples.
+    fs : float
+        Sampling rate (Hz).
+    m : CsvMapping or mapping
+        The checked options: ``units``, ``range``, ``axes``, ``preset``,
+        ``axis_labels`` and ``check_units``.
+    time : numpy.ndarray or None
+        Sample times (s), or None for ``k / fs``.
+    attrs : mapping
+        Recording attributes.
+    allow_nan : bool
+        Whether NaN samples (gaps) are accepted.
+    style : {"mapping", "python"}
+        How the options were given, for error messages.
+
+    Returns
+    -------
+    xarray.Dataset
+        The validated Recording.
     """
-    units, full = m["units"], m["range"]
+    full = m["range"]
     try:
-        return schema.make_recording(
-            get["acc"],
-            get.get("gyr"),
+        return sensor_recording(
+            get,
             fs,
-            acc_units=units["acc"],
-            gyr_units=units.get("gyr"),
-            mag=get.get("mag"),
-            mag_units=units.get("mag"),
+            m["units"],
             acc_range=full.get("acc"),
             gyr_range=full.get("gyr"),
             mag_range=full.get("mag"),
-            temp=get["temp"][:, 0] if "temp" in get else None,
-            temp_units=units.get("temp"),
             q_ref=get.get("q_ref"),
             time=time,
             axes=m["axes"],

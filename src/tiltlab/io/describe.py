@@ -1,6 +1,7 @@
-"""What is this file? One line naming what a data file looks like (:func:`detect`):
-``"tiltlab Recording (NetCDF)"``, ``"tag-tools NetCDF (variables A, M, P; 50 Hz)"``,
-``"BROAD trial (HDF5)"``, ``"MATLAB v7.3 file with variables accelBuffer(12243×4
+"""Say what a data file is, in one line (:func:`detect`).
+
+For example ``"tiltlab Recording (NetCDF)"``,
+``"tag-tools NetCDF (variables A, M, P; 50 Hz)"``, ``"BROAD trial (HDF5)"``, ``"MATLAB v7.3 file with variables accelBuffer(12243×4
 double)"``, ``"CSV with columns …"``. :func:`tiltlab.io.read` uses it to choose a
 reader; the NetCDF reader uses it to say what a file that is not a Recording is.
 """

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import xarray as xr
@@ -11,17 +12,32 @@ from .. import _validate, schema
 from ._common import PathLike, ReadError, _read_table
 
 
-def _existing_file(path: PathLike) -> None:
-    """Refuse a directory given where a file is expected (a missing file is refused
-    by the table reader).
-    """
-    if Path(path).is_dir():
-        raise ReadError(f"{path}: is a directory, not a file")
+def _mpu9250_recording(
+    path: PathLike,
+    df,
+    fs: float,
+    check_units: bool,
+    attrs: dict[str, Any],
+    **options: Any,
+) -> xr.Dataset:
+    """Build a Recording from the ``ax..gz`` columns (g, °/s) of a Fayat et al. table."""
+    return schema.make_recording(
+        df[["ax", "ay", "az"]].to_numpy(),
+        df[["gx", "gy", "gz"]].to_numpy(),
+        fs,
+        acc_units="g",
+        gyr_units="deg/s",
+        check_units=check_units,
+        attrs={"source": str(Path(path).name), **attrs},
+        **options,
+    )
 
 
 def _counter(path: PathLike, column) -> np.ndarray:
-    """The acquisition counter as int64; a non-integer value (a corrupted row) is an
-    error naming the row, never cut to an integer.
+    """Read the acquisition counter as int64.
+
+    A non-integer value (a corrupted row) is an error naming the row, never cut to an
+    integer.
     """
     values = column.to_numpy()
     if values.dtype.kind == "f":
@@ -56,9 +72,24 @@ def read_fayat_imu(
 
     Axes: x points forward (nose), y to the animal's left, z up (dorsal) [1]_.
 
-    References
+    Parameters
     ----------
-    .. [1] R. Fayat et al., Sensors 21(18):6318, 2021. doi:10.3390/s21186318
+    path : path-like
+        ``example_imu.csv``.
+    counter_rate : float, optional
+        Rate of the acquisition counter (Hz).
+    fs : float, optional
+        Nominal sampling rate of the file (Hz).
+    check_units : bool, optional
+        False skips the plausibility check of the g and °/s columns.
+    **attrs
+        Attributes that replace the defaults (``sensor``, ``subject``, ``session``,
+        ``axes``) or add to them.
+
+    Returns
+    -------
+    xarray.Dataset
+        The Recording, with the ``counter`` variable.
 
     Raises
     ------
@@ -66,37 +97,37 @@ def read_fayat_imu(
         A missing file (or a directory), a truncated or unreadable table, or a
         ``counter`` value that is not a whole number (the data row is named; it is
         never cut to an integer).
+
+    References
+    ----------
+    .. [1] R. Fayat et al., Sensors 21(18):6318, 2021. doi:10.3390/s21186318
     """
-    _existing_file(path)
     df = _read_table(
         path, ["counter", "ax", "ay", "az", "gx", "gy", "gz"], final_newline=True
     )
     counter_rate = _validate.positive(counter_rate, "counter_rate")
     counter = _counter(path, df["counter"])
     time = (counter - counter[0]) / counter_rate
-    return schema.make_recording(
-        df[["ax", "ay", "az"]].to_numpy(),
-        df[["gx", "gy", "gz"]].to_numpy(),
+    return _mpu9250_recording(
+        path,
+        df,
         fs,
-        acc_units="g",
-        gyr_units="deg/s",
+        check_units,
+        {
+            "sensor": "MPU9250 (wired head IMU)",
+            "subject": "rat",
+            "session": "example",
+            "axes": "x forward (nose), y left, z up (dorsal)",
+            **attrs,
+        },
         preset="rat_head",
         time=time,
-        check_units=check_units,
         extra={
             "counter": (
                 "time",
                 counter,
                 {"long_name": f"acquisition counter at {counter_rate:g} Hz"},
             )
-        },
-        attrs={
-            "source": str(Path(path).name),
-            "sensor": "MPU9250 (wired head IMU)",
-            "subject": "rat",
-            "session": "example",
-            "axes": "x forward (nose), y left, z up (dorsal)",
-            **attrs,
         },
     )
 
@@ -116,33 +147,41 @@ def read_fayat_tumble(
     clipped while the sensor was turned over are found
     (:func:`tiltlab.quality.saturation`).
 
+    Parameters
+    ----------
+    path : path-like
+        ``example_sensor_calibration.csv``.
+    fs : float, optional
+        Sampling rate (Hz).
+    check_units : bool, optional
+        False skips the unit check of the tumble test's g and °/s columns.
+    **attrs
+        Provenance for ``attrs``, replacing ``sensor="MPU9250"``, ``subject="none"``
+        and ``session="tumble test"`` or adding to them.
+
+    Returns
+    -------
+    xarray.Dataset
+        The Recording, with the full scale in each variable's ``range``.
+
     Raises
     ------
     ReadError
         A missing file (or a directory), or a truncated or unreadable table.
     """
-    _existing_file(path)
     df = _read_table(
         path,
         ["ax", "ay", "az", "gx", "gy", "gz", "time"],
         final_newline=True,
         index_col=0,
     )
-    return schema.make_recording(
-        df[["ax", "ay", "az"]].to_numpy(),
-        df[["gx", "gy", "gz"]].to_numpy(),
+    return _mpu9250_recording(
+        path,
+        df,
         fs,
-        acc_units="g",
-        gyr_units="deg/s",
+        check_units,
+        {"sensor": "MPU9250", "subject": "none", "session": "tumble test", **attrs},
         acc_range=4.0,
         gyr_range=1000.0,
         time=df["time"].to_numpy(),
-        check_units=check_units,
-        attrs={
-            "source": str(Path(path).name),
-            "sensor": "MPU9250",
-            "subject": "none",
-            "session": "tumble test",
-            **attrs,
-        },
     )

@@ -13,7 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ._common import PathLike, ReadError, no_file
+from ._common import PathLike, ReadError, file_head, no_file
 
 #: MATLAB classes that hold numbers (``logical`` included: it reads as 0/1).
 _NUMERIC_CLASSES = frozenset(
@@ -34,12 +34,12 @@ _NUMERIC_CLASSES = frozenset(
 
 
 def mat_version(path: PathLike) -> str | None:
-    """The MATLAB file version from the file header, or None if it is not a MAT-file.
+    """Read the MATLAB file version from the file header; None if not a MAT-file.
 
     Parameters
     ----------
-    path
-        File to inspect.
+    path : path-like
+        The file; its first 128 bytes, the MAT-file header, are read.
 
     Returns
     -------
@@ -48,10 +48,8 @@ def mat_version(path: PathLike) -> str | None:
         ``"4"`` for the old headerless layout when scipy recognises it, None otherwise.
     """
     path = Path(path)
-    try:
-        with open(path, "rb") as f:
-            head = f.read(128)
-    except OSError:
+    head = file_head(path, 128)
+    if head is None:
         return None
     if head.startswith(b"MATLAB 7.3 MAT-file"):
         return "7.3"
@@ -74,7 +72,7 @@ def _describe(name: str, shape: tuple[int, ...], cls: str) -> str:
 
 
 def list_variables(path: PathLike) -> list[tuple[str, tuple[int, ...], str]]:
-    """The variables of a MATLAB file: ``(name, MATLAB shape, MATLAB class)`` each.
+    """List the variables of a MATLAB file: ``(name, MATLAB shape, MATLAB class)`` each.
 
     Parameters
     ----------

@@ -10,7 +10,8 @@ from pathlib import Path
 
 import xarray as xr
 
-from ._common import PathLike, ReadError, no_file
+import tiltlab._deprecate as _deprecate
+from ._common import PathLike, ReadError, file_head, no_file
 
 __all__ = ["netcdf_format", "open_netcdf", "is_recording"]
 
@@ -25,12 +26,12 @@ _MAGIC = {
 
 
 def netcdf_format(path: PathLike) -> str | None:
-    """The NetCDF flavour of a file from its first bytes, or None if it is not NetCDF.
+    """Name the NetCDF flavour of a file from its first bytes; None if it is not NetCDF.
 
     Parameters
     ----------
-    path
-        File to inspect.
+    path : path-like
+        The file; its first 8 bytes, the format signature, are read.
 
     Returns
     -------
@@ -38,10 +39,8 @@ def netcdf_format(path: PathLike) -> str | None:
         ``"NetCDF-4"`` (an HDF5 file), ``"NetCDF-3 classic"``, ``"NetCDF-3 64-bit
         offset"``, ``"NetCDF-3 64-bit data (CDF-5)"``, or None.
     """
-    try:
-        with open(path, "rb") as f:
-            head = f.read(8)
-    except OSError:
+    head = file_head(path, 8)
+    if head is None:
         return None
     if head == b"\x89HDF\r\n\x1a\n":
         return "NetCDF-4"
@@ -94,20 +93,21 @@ def open_netcdf(path: PathLike) -> xr.Dataset:
         ) from None
 
 
-def is_recording(ds: xr.Dataset) -> bool:
-    """True if an opened NetCDF file holds a tiltlab Recording (or a file tiltlab wrote).
+@_deprecate.renamed(ds="data")
+def is_recording(data: xr.Dataset) -> bool:
+    """Tell whether an opened NetCDF file holds a tiltlab Recording (or tiltlab wrote it).
 
     Parameters
     ----------
-    ds : xarray.Dataset
+    data : xarray.Dataset
         An opened NetCDF file.
 
     Returns
     -------
     bool
-        True if ``ds`` carries tiltlab's attributes, or has an ``acc`` variable, a
+        True if ``data`` carries tiltlab's attributes, or has an ``acc`` variable, a
         ``time`` dimension and an ``fs`` attribute.
     """
-    if _ATTRS_KEY in ds.attrs:
+    if _ATTRS_KEY in data.attrs:
         return True
-    return "acc" in ds.data_vars and "time" in ds.dims and "fs" in ds.attrs
+    return "acc" in data.data_vars and "time" in data.dims and "fs" in data.attrs

@@ -25,6 +25,7 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
+import tiltlab._deprecate as _deprecate
 from .. import schema
 from ._common import IntegrityError, PathLike, ReadError, no_file
 from .tagtools import looks_like_tagtools
@@ -96,11 +97,16 @@ def _checksum_record(ds: xr.Dataset, blob: str) -> dict:
 
 
 def netcdf_checksums(path: PathLike) -> dict | None:
-    """The checksums :func:`save_netcdf` stored in a file, or None if it has none.
+    """Read the checksums :func:`save_netcdf` stored in a file, or None if it has none.
 
     Reads the one attribute only (the data are not read, nor checked: that is what
     :func:`load_netcdf` does). Files written before tiltlab stored checksums, and
     files written by other tools, have none.
+
+    Parameters
+    ----------
+    path : path-like
+        A NetCDF-4 file.
 
     Returns
     -------
@@ -197,8 +203,9 @@ def _verify(path: Path, ds: xr.Dataset, record: dict, blob: str | None) -> None:
         )
 
 
-def save_netcdf(ds: xr.Dataset, path: PathLike) -> Path:
-    """Write a Dataset to NetCDF-4 (h5netcdf engine) so that :func:`load_netcdf` returns it exactly.
+@_deprecate.renamed(ds="rec")
+def save_netcdf(rec: xr.Dataset, path: PathLike) -> Path:
+    """Write a Dataset to NetCDF-4 (h5netcdf) so that :func:`load_netcdf` returns it exactly.
 
     NetCDF attributes cannot hold booleans, dicts or None, so every attribute (of the
     dataset, its variables and coordinates) is also stored as JSON and restored on load.
@@ -206,15 +213,27 @@ def save_netcdf(ds: xr.Dataset, path: PathLike) -> Path:
     ``_tiltlab_sha256``), and checked by :func:`load_netcdf`. Values are written as
     they are in memory: encodings carried over from a file the Dataset was read from
     (scale factors, packed dtypes, fill values …) are not applied.
+
+    Parameters
+    ----------
+    rec : xarray.Dataset
+        The Dataset (a Recording, or any other).
+    path : path-like
+        The file to write (replaced if it exists).
+
+    Returns
+    -------
+    Path
+        The file written.
     """
-    if not isinstance(ds, xr.Dataset):
+    if not isinstance(rec, xr.Dataset):
         raise TypeError(
-            f"save_netcdf writes a Recording (xarray.Dataset), got {type(ds).__name__}"
+            f"save_netcdf writes a Recording (xarray.Dataset), got {type(rec).__name__}"
         )
     path = Path(path)
-    out = ds.copy()
-    record = {"__dataset__": dict(ds.attrs)}
-    for name, var in ds.variables.items():
+    out = rec.copy()
+    record = {"__dataset__": dict(rec.attrs)}
+    for name, var in rec.variables.items():
         record[str(name)] = dict(var.attrs)
     try:
         blob = json.dumps(record, default=_json_default)
@@ -222,14 +241,14 @@ def save_netcdf(ds: xr.Dataset, path: PathLike) -> Path:
         raise ValueError(f"cannot save attributes: {exc}") from None
     out.attrs = {
         k: v
-        for k, v in ds.attrs.items()
+        for k, v in rec.attrs.items()
         if isinstance(v, (str, int, float, np.number)) and not isinstance(v, bool)
     }
     out.attrs[_ATTRS_KEY] = blob
     for name, var in out.variables.items():
         var.attrs = {
             k: v
-            for k, v in ds[name].attrs.items()
+            for k, v in rec[name].attrs.items()
             if isinstance(v, (str, int, float, np.number)) and not isinstance(v, bool)
         }
         # lossy encodings (int16 packing, fill values, coarse time units) would make
@@ -242,8 +261,9 @@ def save_netcdf(ds: xr.Dataset, path: PathLike) -> Path:
 
 
 class NotRecordingError(ReadError):
-    """A readable file that is not a tiltlab Recording; the message says what it looks
-    like and how to convert it.
+    """A readable file that is not a tiltlab Recording.
+
+    The message says what it looks like and how to convert it.
     """
 
     def __init__(self, path: PathLike, looks_like: str):
@@ -265,6 +285,7 @@ class NotRecordingError(ReadError):
         )
 
     def __reduce__(self):
+        """Pickle the error by its path and what the file looks like."""
         return (NotRecordingError, (self.path, self.looks_like))
 
 
@@ -286,6 +307,8 @@ def load_netcdf(
 
     Parameters
     ----------
+    path : path-like
+        The file.
     validate : bool
         Also run :func:`tiltlab.schema.validate` (for Recordings).
     verify : bool
@@ -294,6 +317,11 @@ def load_netcdf(
     **validate_kwargs
         Passed to :func:`tiltlab.schema.validate` (``allow_nan`` defaults to whether the
         file holds NaN; ``check_units=False`` accepts the unit labels as they are).
+
+    Returns
+    -------
+    xarray.Dataset
+        The Dataset as saved, loaded into memory, attributes restored.
 
     Raises
     ------

@@ -21,9 +21,10 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
+import tiltlab._deprecate as _deprecate
 from .. import schema
 from ..quality import QualityWarning
-from ._common import PathLike, ReadError
+from ._common import PathLike, ReadError, sensor_recording
 from .ncfile import open_netcdf
 
 #: tiltlab role of each tag-tools variable name (first match wins).
@@ -113,7 +114,18 @@ def sensor_variables(ds: xr.Dataset) -> dict[str, str]:
 
 
 def looks_like_tagtools(ds: xr.Dataset) -> bool:
-    """True if an opened NetCDF file has the tag-tools layout (a sensor with a rate)."""
+    """Tell whether an opened NetCDF file has the tag-tools layout (a sensor with a rate).
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        The opened file.
+
+    Returns
+    -------
+    bool
+        True if a variable has a tiltlab role and a sampling rate.
+    """
     return bool(sensor_variables(ds))
 
 
@@ -138,7 +150,7 @@ def _rate(var: xr.DataArray, path: Path) -> float:
 
 
 def _samples_first(var: xr.DataArray, path: Path, width: int | None) -> np.ndarray:
-    """The variable's values with samples along the first axis."""
+    """Return the variable's values with samples along the first axis."""
     values = np.asarray(var.values, dtype=float)
     if values.ndim == 1:
         return values if width in (None, 1) else values.reshape(-1, 1)
@@ -243,6 +255,40 @@ def read_tagtools(
     """
     path = Path(path)
     ds = open_netcdf(path)
+    found = _select_sensors(ds, path, variables)
+    fs = _common_rate(ds, found, path)
+    widths = {"acc": 3, "mag": 3, "gyr": 3, "depth": 1, "temp": 1}
+    data = {r: _samples_first(ds[n], path, widths[r]) for r, n in found.items()}
+    data = _same_length(data, found, path)
+    given = {"acc": acc_units, "mag": mag_units, "gyr": gyr_units}
+    units = _sensor_units(ds, found, path, given)
+    axis_kw = _axis_options(ds, found, path, axes, preset)
+    meta, extra, t0 = _metadata(ds, found, data, path)
+    try:
+        return sensor_recording(
+            data,
+            fs,
+            units,
+            t0=t0,
+            extra=extra or None,
+            attrs={**meta, **attrs},
+            check_units=check_units,
+            # missing samples (NaN) are kept as gaps, as read_csv(gaps="nan") does
+            allow_nan=any(
+                bool(np.isnan(v).any()) for v in data.values() if v.dtype.kind == "f"
+            ),
+            **axis_kw,
+        )
+    except ValueError as exc:
+        if isinstance(exc, schema.RecordingError):
+            raise
+        raise ReadError(f"{path}: {exc}") from None
+
+
+def _select_sensors(
+    ds: xr.Dataset, path: Path, variables: Sequence[str] | None
+) -> dict[str, str]:
+    """Role → variable name of the sensors to read (``acc`` required)."""
     found = sensor_variables(ds)
     if variables is not None:
         wanted = [str(v) for v in variables]
@@ -259,6 +305,11 @@ def read_tagtools(
             "sensor variables found: "
             + (", ".join(f"{n} ({r})" for r, n in found.items()) or "none")
         )
+    return found
+
+
+def _common_rate(ds: xr.Dataset, found: Mapping[str, str], path: Path) -> float:
+    """Find the one sampling rate of the sensors; different rates are refused."""
     rates = {n: _rate(ds[n], path) for n in found.values()}
     distinct = sorted(set(rates.values()))
     if len(distinct) > 1:
@@ -270,70 +321,93 @@ def read_tagtools(
             f"variables={same!r}, or decimate the others to "
             f"{rates[found['acc']]:g} Hz first (tag-tools decdc)"
         )
-    fs = distinct[0]
-    widths = {"acc": 3, "mag": 3, "gyr": 3, "depth": 1, "temp": 1}
-    data = {r: _samples_first(ds[n], path, widths[r]) for r, n in found.items()}
+    return distinct[0]
+
+
+def _same_length(
+    data: dict[str, np.ndarray], found: Mapping[str, str], path: Path
+) -> dict[str, np.ndarray]:
+    """Cut the sensors to a common length (a few samples at most, with a warning)."""
     lengths = {found[r]: len(v) for r, v in data.items()}
     n = min(lengths.values())
-    if max(lengths.values()) != n:
-        if max(lengths.values()) - n > max(2, 0.01 * n):
-            raise ReadError(
-                f"{path}: sensors at the same rate have different lengths "
-                f"({', '.join(f'{k} {v}' for k, v in lengths.items())}); they do not "
-                "cover the same time: read some with variables=[...]"
-            )
-        warnings.warn(
-            f"{path.name}: sensors differ in length by "
-            f"{max(lengths.values()) - n} sample(s) "
-            f"({', '.join(f'{k} {v}' for k, v in lengths.items())}); "
-            f"kept the first {n}",
-            QualityWarning,
-            stacklevel=2,
+    if max(lengths.values()) == n:
+        return data
+    listed = ", ".join(f"{k} {v}" for k, v in lengths.items())
+    if max(lengths.values()) - n > max(2, 0.01 * n):
+        raise ReadError(
+            f"{path}: sensors at the same rate have different lengths "
+            f"({listed}); they do not cover the same time: read some with "
+            "variables=[...]"
         )
-        data = {r: v[:n] for r, v in data.items()}
+    warnings.warn(
+        f"{path.name}: sensors differ in length by "
+        f"{max(lengths.values()) - n} sample(s) ({listed}); kept the first {n}",
+        QualityWarning,
+        stacklevel=3,
+    )
+    return {r: v[:n] for r, v in data.items()}
 
+
+def _sensor_units(
+    ds: xr.Dataset,
+    found: Mapping[str, str],
+    path: Path,
+    given: Mapping[str, str | None],
+) -> dict[str, str | None]:
+    """Each sensor's unit: as given, else as the file states it."""
     units: dict[str, str | None] = {
         r: _unit(ds[found[r]]) for r in ("acc", "mag", "gyr", "temp") if r in found
     }
-    for role, given in (("acc", acc_units), ("mag", mag_units), ("gyr", gyr_units)):
-        if given is not None and role in found:
-            units[role] = given
+    units.update({r: u for r, u in given.items() if u is not None and r in found})
     no_unit = [found[r] for r, u in units.items() if not u]
     if no_unit:
         raise ReadError(
             f"{path}: variable(s) {no_unit} state no unit; give them, e.g. "
             "acc_units='m/s^2', mag_units='uT' (tag-tools' defaults)"
         )
+    return units
 
-    axis_kw: dict[str, Any] = {}
+
+def _axis_options(
+    ds: xr.Dataset,
+    found: Mapping[str, str],
+    path: Path,
+    axes: Sequence[str] | Mapping[str, Sequence[str]] | None,
+    preset: str | None,
+) -> dict[str, Any]:
+    """``axes``/``preset`` for make_recording, from the arguments or the file's axes."""
     if axes is not None or preset is not None:
         # a tag-tools frame is left-handed unless a preset says otherwise
-        axis_kw = {"axes": axes, "preset": preset or "tagtools"}
-    else:
-        codes = {
-            r: str(_attr(ds[found[r]], "axes") or "FRU")
-            for r in ("acc", "mag", "gyr")
-            if r in found
-        }
-        specs = {r: _axes_spec(c, found[r], path) for r, c in codes.items()}
-        if all(c.strip().upper() == "FRU" for c in codes.values()):
-            axis_kw = {"preset": "tagtools"}
-        else:
-            hands = {r: _handedness(spec) for r, spec in specs.items()}
-            if len(set(hands.values())) > 1:
-                raise ReadError(
-                    f"{path}: the sensors' axes differ in handedness ("
-                    + ", ".join(f"{found[r]} {codes[r]!r}" for r in codes)
-                    + "); give axes={...} per sensor saying which column points "
-                    "forward, left and up"
-                )
-            # tagtools: left-handed device frame; animal: right-handed; both label
-            # the result forward, left, up
-            hand = hands["acc"] if "acc" in hands else next(iter(hands.values()))
-            axis_kw = {
-                "preset": "tagtools" if hand == "left" else "animal",
-                "axes": {"*": specs.get("acc", next(iter(specs.values()))), **specs},
-            }
+        return {"axes": axes, "preset": preset or "tagtools"}
+    codes = {
+        r: str(_attr(ds[found[r]], "axes") or "FRU")
+        for r in ("acc", "mag", "gyr")
+        if r in found
+    }
+    specs = {r: _axes_spec(c, found[r], path) for r, c in codes.items()}
+    if all(c.strip().upper() == "FRU" for c in codes.values()):
+        return {"preset": "tagtools"}
+    hands = {r: _handedness(spec) for r, spec in specs.items()}
+    if len(set(hands.values())) > 1:
+        raise ReadError(
+            f"{path}: the sensors' axes differ in handedness ("
+            + ", ".join(f"{found[r]} {codes[r]!r}" for r in codes)
+            + "); give axes={...} per sensor saying which column points "
+            "forward, left and up"
+        )
+    # tagtools: left-handed device frame; animal: right-handed; both label
+    # the result forward, left, up
+    hand = hands["acc"] if "acc" in hands else next(iter(hands.values()))
+    return {
+        "preset": "tagtools" if hand == "left" else "animal",
+        "axes": {"*": specs.get("acc", next(iter(specs.values()))), **specs},
+    }
+
+
+def _metadata(
+    ds: xr.Dataset, found: Mapping[str, str], data: Mapping[str, np.ndarray], path: Path
+) -> tuple[dict[str, Any], dict[str, Any], float]:
+    """Provenance attributes, the depth variable (if any) and the start offset."""
     frames = sorted(
         {
             str(_attr(ds[found[r]], "frame") or "tag")
@@ -341,7 +415,6 @@ def read_tagtools(
             if r in found
         }
     )
-
     extra = {}
     if "depth" in found:
         var = ds[found["depth"]]
@@ -372,39 +445,16 @@ def read_tagtools(
         t0 = float(offset) if offset is not None else 0.0
     except (TypeError, ValueError):
         t0 = 0.0
-    try:
-        return schema.make_recording(
-            data["acc"],
-            data.get("gyr"),
-            fs,
-            acc_units=units["acc"],
-            gyr_units=units.get("gyr"),
-            mag=data.get("mag"),
-            mag_units=units.get("mag"),
-            temp=data["temp"].reshape(-1) if "temp" in data else None,
-            temp_units=units.get("temp"),
-            t0=t0,
-            extra=extra or None,
-            attrs={**meta, **attrs},
-            check_units=check_units,
-            # missing samples (NaN) are kept as gaps, as read_csv(gaps="nan") does
-            allow_nan=any(
-                bool(np.isnan(v).any()) for v in data.values() if v.dtype.kind == "f"
-            ),
-            **axis_kw,
-        )
-    except ValueError as exc:
-        if isinstance(exc, schema.RecordingError):
-            raise
-        raise ReadError(f"{path}: {exc}") from None
+    return meta, extra, t0
 
 
 #: tag-tools variable name of each Recording variable written by :func:`write_tagtools`.
 _WRITE_NAMES = {"acc": "A", "mag": "M", "gyr": "G", "temp": "T"}
 
 
+@_deprecate.renamed(recording="rec")
 def write_tagtools(
-    recording: xr.Dataset,
+    rec: xr.Dataset,
     path: PathLike,
     *,
     axes: str = "FRU",
@@ -424,7 +474,7 @@ def write_tagtools(
 
     Parameters
     ----------
-    recording : xarray.Dataset
+    rec : xarray.Dataset
         A Recording (``acc``; ``mag``, ``gyr``, ``temp`` written when present).
     path : path-like
         The ``.nc`` file to write (replaced if it exists).
@@ -449,9 +499,9 @@ def write_tagtools(
     >>> bool(abs(back["acc"] - rec["acc"].values).max() < 1e-12)
     True
     """
-    if not isinstance(recording, xr.Dataset) or "acc" not in recording:
+    if not isinstance(rec, xr.Dataset) or "acc" not in rec:
         raise TypeError("write_tagtools needs a Recording (an xarray.Dataset with acc)")
-    schema.validate(recording, allow_nan=True, check_units=False)
+    schema.validate(rec, allow_nan=True, check_units=False)
     path = Path(path)
     code = str(axes).strip().upper()
     if len(code) != 3 or sorted(_LETTERS[c][0] for c in code if c in _LETTERS) != [
@@ -470,12 +520,12 @@ def write_tagtools(
         order[col] = (our_axis, sign)
     if format not in ("NETCDF4", "NETCDF3_64BIT"):
         raise ValueError(f"format must be 'NETCDF4' or 'NETCDF3_64BIT', got {format!r}")
-    fs = float(recording.attrs["fs"])
+    fs = float(rec.attrs["fs"])
     out = {}
     for var, name in _WRITE_NAMES.items():
-        if var not in recording:
+        if var not in rec:
             continue
-        da = recording[var]
+        da = rec[var]
         attrs = {
             "sampling_rate": fs,
             "sampling_rate_unit": "Hz",
@@ -493,9 +543,7 @@ def write_tagtools(
             values, dims = np.asarray(da.values, float), (f"{name} samples",)
         out[name] = (dims, values.astype(float), attrs)
     glob = {
-        "depid": str(
-            recording.attrs.get("session") or recording.attrs.get("subject", "")
-        ),
+        "depid": str(rec.attrs.get("session") or rec.attrs.get("subject", "")),
         "creator": "tiltlab.io.write_tagtools",
     }
     ds = xr.Dataset(out, attrs={k: v for k, v in glob.items() if v})
