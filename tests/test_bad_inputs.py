@@ -918,7 +918,7 @@ case(
 )
 case(
     "cal-detect_static-offset-shape",
-    lambda t: cal.detect_static(REC6, offset=[1.0, 2.0]),
+    lambda t: cal.detect_static(REC6, gyr_offset=[1.0, 2.0]),
     ValueError,
     r"offset",
 )
@@ -1289,7 +1289,7 @@ case(
 case(
     "cal-head_frame-coincident",
     lambda t: cal.head_frame_from_markers(ACC, ACC, GYR),
-    cal.CalibrationError,
+    ValueError,
     r"coincident",
 )
 case(
@@ -2086,7 +2086,7 @@ case(
 )
 case(
     "behavior-recording_speed-offset",
-    lambda t: behavior.recording_speed(REC6, offset="median"),
+    lambda t: behavior.recording_speed(REC6, gyr_offset="median"),
     ValueError,
     r"offset.*median",
 )

@@ -287,7 +287,7 @@ def test_gap_free_recording_is_unchanged():
     rec = _recording(acc, gyr, t)
     q = F.estimate(rec, "mahony")
     assert "n_segments" not in q.attrs and "segments" not in q.attrs
-    assert np.array_equal(q.values, F.run("mahony", F.prepare(rec)))
+    assert np.array_equal(q.values, F.run_method("mahony", F.prepare(rec)))
     qs, warned = _estimate_quietly(rec, "mahony", gaps="segments")
     assert not warned and qs.attrs["n_segments"] == 1
     assert np.array_equal(qs.values, q.values)

@@ -110,8 +110,8 @@ def test_every_gyroscope_method_is_refused_by_name(with_mag):
     inputs = F.prepare(rec)
     assert inputs.gyr is None
     with pytest.raises(RecordingError, match="'madgwick' needs a gyroscope"):
-        F.run("madgwick", inputs)
-    assert F.run("lowpass", inputs).shape == (rec.sizes["time"], 4)
+        F.run_method("madgwick", inputs)
+    assert F.run_method("lowpass", inputs).shape == (rec.sizes["time"], 4)
 
 
 def test_estimate_ignores_a_broken_gyroscope_it_does_not_use():

@@ -223,8 +223,8 @@ def test_quaternion_slerp_shortest_path_and_antipodes():
 
 def test_sphere_slerp_at_antipodes_is_an_error_not_a_jump():
     with pytest.raises(ValueError, match=r"opposite directions.*not unique"):
-        sphere.slerp([0.0, 0, 1], [0.0, 0, -1], np.linspace(0, 1, 5))
-    same = sphere.slerp([0.0, 0, 1], [0.0, 0, 1], np.linspace(0, 1, 5))
+        sphere.slerp_vectors([0.0, 0, 1], [0.0, 0, -1], np.linspace(0, 1, 5))
+    same = sphere.slerp_vectors([0.0, 0, 1], [0.0, 0, 1], np.linspace(0, 1, 5))
     np.testing.assert_allclose(same, np.tile([0.0, 0, 1], (5, 1)))
     g = np.array([[0.0, 0, 1], [0.0, 0, 1], [0.0, 0, -1]])
     with pytest.raises(ValueError, match=r"samples 1 and 2 are opposite"):
@@ -350,9 +350,9 @@ def test_learned_run_refuses_a_recording_shorter_than_the_window():
     with pytest.raises(
         ValueError, match=rf"has {window + 1} samples.*window is {window} samples"
     ):
-        learn.run(model, seq(window + 1), cfg)
+        learn.closed_loop_estimate(model, seq(window + 1), cfg)
     with torch.no_grad():
-        out = learn.run(model, seq(window + 2), cfg)
+        out = learn.closed_loop_estimate(model, seq(window + 2), cfg)
     assert out.shape == (window + 2, 4)
 
 

@@ -1,4 +1,10 @@
-"""One validation module: how every public function reads its inputs and reports problems.
+"""Check function arguments: how every public function reads its inputs and reports problems.
+
+What belongs here: the checks of arguments (arrays, labelled inputs, sampling rates,
+scalars, time gaps) and :class:`RecordingError`. What does not: what a Recording is
+and its validation (:mod:`tiltlab.schema`), data-quality findings such as saturation or
+units the values contradict (:mod:`tiltlab.quality`), and the unit table
+(:mod:`tiltlab.units`).
 
 Layer 1 (beside :mod:`tiltlab.units`). Every science function that takes data calls
 :func:`signal` (or :func:`vectors` / the scalar checks) instead of writing its own checks,
@@ -31,12 +37,13 @@ is an error naming it.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
-from typing import Any
+from dataclasses import dataclass, field, replace
+from typing import Any, TypedDict, Unpack
 
 import numpy as np
 import xarray as xr
 
+from ._scalars import check_fs, finite, fraction, integer, nonnegative, positive
 from .units import conversion_factor, normalise_unit
 
 __all__ = [
@@ -62,95 +69,10 @@ class RecordingError(ValueError):
     """A Recording breaks the data contract; the message names what is wrong."""
 
 
-# --------------------------------------------------------------------------- scalars
-
-
-def check_fs(fs, name: str = "fs") -> float:
-    """A sampling rate as a positive finite float (Hz); ``None`` or anything else is an error.
-
-    tiltlab never assumes a default sampling rate.
-    """
-    if fs is None:
-        raise ValueError(
-            f"{name} (sampling rate, Hz) is mandatory; tiltlab never assumes a default"
-        )
-    if isinstance(fs, bool):
-        raise ValueError(f"{name} must be a number of Hz, got {fs!r}")
-    try:
-        value = float(fs)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be a number of Hz, got {fs!r}") from None
-    if not np.isfinite(value) or value <= 0:
-        raise ValueError(f"{name} must be a positive finite number of Hz, got {fs!r}")
-    return value
-
-
-def _number(value, name: str) -> float:
-    if isinstance(value, bool) or value is None:
-        raise ValueError(f"{name} must be a number, got {value!r}")
-    try:
-        return float(value)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be a number, got {value!r}") from None
-
-
-def finite(value, name: str) -> float:
-    """``value`` as a finite float, else a :class:`ValueError` naming ``name``."""
-    v = _number(value, name)
-    if not np.isfinite(v):
-        raise ValueError(f"{name} must be finite, got {value!r}")
-    return v
-
-
-def positive(
-    value, name: str, *, allow_zero: bool = False, allow_inf: bool = False
-) -> float:
-    """``value`` as a positive float (``> 0``, or ``>= 0`` with ``allow_zero``)."""
-    v = _number(value, name)
-    if (
-        np.isnan(v)
-        or (np.isinf(v) and not allow_inf)
-        or v < 0
-        or (v == 0 and not allow_zero)
-    ):
-        kind = "non-negative" if allow_zero else "positive"
-        raise ValueError(f"{name} must be a {kind} number, got {value!r}")
-    return v
-
-
-def nonnegative(value, name: str) -> float:
-    """``value`` as a finite float ``>= 0``."""
-    return positive(value, name, allow_zero=True)
-
-
-def integer(value, name: str, *, minimum: int | None = None) -> int:
-    """``value`` as an int (integral floats accepted), at least ``minimum`` if given."""
-    if isinstance(value, bool) or value is None:
-        raise ValueError(f"{name} must be an integer, got {value!r}")
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be an integer, got {value!r}") from None
-    if not np.isfinite(v) or v != int(v):
-        raise ValueError(f"{name} must be an integer, got {value!r}")
-    if minimum is not None and v < minimum:
-        raise ValueError(f"{name} must be at least {minimum}, got {value!r}")
-    return int(v)
-
-
-def fraction(
-    value, name: str, *, open_low: bool = False, open_high: bool = False
-) -> float:
-    """``value`` as a float in [0, 1] (ends excluded with ``open_low`` / ``open_high``)."""
-    v = finite(value, name)
-    if v < 0 or v > 1 or (open_low and v == 0) or (open_high and v == 1):
-        lo = "(" if open_low else "["
-        hi = ")" if open_high else "]"
-        raise ValueError(f"{name} must be in {lo}0, 1{hi}, got {value!r}")
-    return v
-
-
 # --------------------------------------------------------------------------- arrays
+#
+# Scalar checks (check_fs, finite, positive, nonnegative, integer, fraction) live in
+# tiltlab._scalars and are re-exported here.
 
 
 def vectors(
@@ -162,7 +84,7 @@ def vectors(
     allow_nan: bool = False,
     min_length: int = 0,
 ) -> np.ndarray:
-    """A float copy of ``a`` checked for shape and finiteness.
+    """Return a float copy of ``a`` checked for shape and finiteness.
 
     Parameters
     ----------
@@ -178,6 +100,11 @@ def vectors(
         Accept NaN (never ±inf).
     min_length : int
         Minimum size of the first dimension.
+
+    Returns
+    -------
+    numpy.ndarray of float
+        A new array (never a view of ``a``).
 
     Raises
     ------
@@ -233,11 +160,23 @@ _TIME_UNIT_STEPS = (("milliseconds", 1e3), ("microseconds", 1e6), ("nanoseconds"
 
 
 def time_unit_hint(step: float, fs: float) -> str:
-    """A hint naming the time unit that makes a median step ``step`` agree with ``fs``.
+    """Name the time unit that makes a median step ``step`` agree with ``fs``.
 
     When ``step * fs`` is close (within 1 %) to 10³, 10⁶ or 10⁹, the time axis is most
     likely in milliseconds, microseconds or nanoseconds instead of seconds; the hint
-    says so (``""`` otherwise).
+    says so.
+
+    Parameters
+    ----------
+    step : float
+        The median time step, in the time axis' own unit.
+    fs : float
+        The sampling rate (Hz).
+
+    Returns
+    -------
+    str
+        The hint, to append to a message (``""`` when no unit explains the step).
     """
     if not (np.isfinite(step) and step > 0):
         return ""
@@ -252,7 +191,7 @@ def time_unit_hint(step: float, fs: float) -> str:
 
 
 def _numeric_time(coord, where: str) -> np.ndarray:
-    """A time coordinate as float seconds; date-times and durations are refused by name."""
+    """Return a time coordinate as float seconds; refuse date-times and durations by name."""
     values = np.asarray(coord.values)
     if values.dtype.kind in "mM":
         kind = "date-times" if values.dtype.kind == "M" else "durations"
@@ -301,6 +240,67 @@ def _time_fs_check(time: np.ndarray, fs: float, where: str) -> None:
         )
 
 
+class Shape(TypedDict, total=False):
+    """Shape requirements of :func:`signal`, passed on to :func:`vectors`."""
+
+    width: int | None
+    ndim: int | None
+
+
+def _source(data, name: str, var: str | None):
+    """Return ``(DataArray or None, attrs, own fs, own units, where)`` of an input."""
+    if isinstance(data, xr.Dataset):
+        key = var or name
+        if key not in data:
+            raise RecordingError(
+                f"the Recording has no variable {key!r} (needed for {name})"
+            )
+        da = data[key]
+        where = f"Recording variable {key!r}"
+        return da, dict(data.attrs), data.attrs.get("fs"), da.attrs.get("units"), where
+    if isinstance(data, xr.DataArray):
+        da = data.transpose("time", ...) if "time" in data.dims else data
+        attrs = dict(da.attrs)
+        return da, attrs, attrs.get("fs"), attrs.get("units"), name
+    return None, {}, None, None, name
+
+
+def _agreed_fs(own_fs, fs, name: str, where: str, need_fs: bool, labelled: bool):
+    """Return the sampling rate of an input: its attribute and ``fs`` must agree."""
+    if own_fs is not None:
+        f = check_fs(own_fs, name=f"{where} attribute fs")
+        if fs is not None and not np.isclose(check_fs(fs), f, rtol=1e-9, atol=0.0):
+            raise RecordingError(
+                f"{name}: fs = {fs!r} contradicts the data's attribute fs = {f:g} Hz"
+            )
+        return f
+    if fs is not None:
+        return check_fs(fs)
+    if need_fs:
+        hint = "add attrs['fs'] to it" if labelled else "pass fs="
+        raise RecordingError(
+            f"{name}: the sampling rate fs is unknown ({hint}); tiltlab never assumes a default"
+        )
+    return None
+
+
+def _agreed_units(own_units, units, name: str, need: bool, labelled: bool):
+    """Return the canonical units of an input: its attribute and ``units`` must agree."""
+    u = None
+    if own_units is not None:
+        u = normalise_unit(own_units)
+        if units is not None and normalise_unit(units) != u:
+            raise RecordingError(
+                f"{name}: units = {units!r} contradicts the data's units {own_units!r}"
+            )
+    elif units is not None:
+        u = normalise_unit(units)
+    if u is None and need:
+        hint = "add attrs['units'] to it" if labelled else "pass units="
+        raise RecordingError(f"{name}: its units are unknown ({hint})")
+    return u
+
+
 def signal(
     data,
     name: str,
@@ -311,9 +311,8 @@ def signal(
     to_units: str | None = None,
     need_fs: bool = True,
     need_units: bool = False,
-    width: int | None = 3,
-    ndim: int | None = 2,
     allow_nan: bool = False,
+    **shape: Unpack[Shape],
 ) -> Signal:
     """Read one input from a Recording, a labelled DataArray or a plain array.
 
@@ -335,14 +334,17 @@ def signal(
         Convert the values to these units (the input's units are then required).
     need_fs, need_units : bool
         Raise when the sampling rate / units cannot be determined.
-    width, ndim : int, optional
-        Shape requirements (see :func:`vectors`).
     allow_nan : bool
         Accept NaN values.
+    **shape
+        ``width`` and ``ndim``: the shape requirements of :func:`vectors` (default
+        ``width=3, ndim=2``, an (N, 3) array; ``None``: any).
 
     Returns
     -------
     Signal
+        The values (a new float array) with the sampling rate, units, time coordinate
+        and attributes read from the input.
 
     Raises
     ------
@@ -353,74 +355,31 @@ def signal(
         the likely time unit).
     ValueError
         Complex, non-numeric, mis-shaped or non-finite values (see :func:`vectors`).
+    TypeError
+        A keyword other than those above.
     """
-    attrs: dict[str, Any] = {}
+    unknown = set(shape) - set(Shape.__annotations__)
+    if unknown:
+        raise TypeError(f"signal() got unexpected keyword arguments {sorted(unknown)}")
+    shape = {"width": 3, "ndim": 2, **shape}
+    da, attrs, own_fs, own_units, where = _source(data, name, var)
+    labelled = da is not None
     time = None
-    labelled = False
-    where = name
-    if isinstance(data, xr.Dataset):
-        key = var or name
-        if key not in data:
-            raise RecordingError(
-                f"the Recording has no variable {key!r} (needed for {name})"
-            )
-        da = data[key]
-        attrs = dict(data.attrs)
-        own_fs = data.attrs.get("fs")
-        own_units = da.attrs.get("units")
-        where = f"Recording variable {key!r}"
-        labelled = True
-    elif isinstance(data, xr.DataArray):
-        da = data.transpose("time", ...) if "time" in data.dims else data
-        attrs = dict(da.attrs)
-        own_fs = da.attrs.get("fs")
-        own_units = da.attrs.get("units")
-        labelled = True
-    else:
-        da = None
-        own_fs = None
-        own_units = None
     if labelled:
         raw = np.asarray(da.values)
         _not_complex(raw, name)
         values = np.array(raw, dtype=float)
         if "time" in da.coords and da.coords["time"].ndim == 1:
             time = _numeric_time(da.coords["time"], where)
-        values = vectors(values, name, width=width, ndim=ndim, allow_nan=allow_nan)
+        values = vectors(values, name, allow_nan=allow_nan, **shape)
     else:
-        values = vectors(data, name, width=width, ndim=ndim, allow_nan=allow_nan)
-
-    # sampling rate: attrs and argument must agree
-    f = None
-    if own_fs is not None:
-        f = check_fs(own_fs, name=f"{where} attribute fs")
-        if fs is not None and not np.isclose(check_fs(fs), f, rtol=1e-9, atol=0.0):
-            raise RecordingError(
-                f"{name}: fs = {fs!r} contradicts the data's attribute fs = {f:g} Hz"
-            )
-    elif fs is not None:
-        f = check_fs(fs)
-    elif need_fs:
-        hint = "add attrs['fs'] to it" if labelled else "pass fs="
-        raise RecordingError(
-            f"{name}: the sampling rate fs is unknown ({hint}); tiltlab never assumes a default"
-        )
+        values = vectors(data, name, allow_nan=allow_nan, **shape)
+    f = _agreed_fs(own_fs, fs, name, where, need_fs, labelled)
     if f is not None and time is not None:
         _time_fs_check(time, f, where)
-
-    # units: attrs and argument must agree
-    u = None
-    if own_units is not None:
-        u = normalise_unit(own_units)
-        if units is not None and normalise_unit(units) != u:
-            raise RecordingError(
-                f"{name}: units = {units!r} contradicts the data's units {own_units!r}"
-            )
-    elif units is not None:
-        u = normalise_unit(units)
-    if u is None and (need_units or to_units is not None):
-        hint = "add attrs['units'] to it" if labelled else "pass units="
-        raise RecordingError(f"{name}: its units are unknown ({hint})")
+    u = _agreed_units(
+        own_units, units, name, need_units or to_units is not None, labelled
+    )
     if to_units is not None:
         values = values * conversion_factor(u, to_units)
         u = normalise_unit(to_units)
@@ -437,10 +396,32 @@ def labelled(
     coords: dict | None = None,
     attrs: dict[str, Any] | None = None,
 ):
-    """Wrap a per-sample result as a DataArray when its input was labelled, else return it.
+    """Wrap a per-sample result as a DataArray when its input was labelled.
 
     The output keeps the input's ``time`` coordinate and ``fs``; ``units`` and ``attrs``
     are added. Plain-array inputs give plain arrays back.
+
+    Parameters
+    ----------
+    values : array_like
+        The result, first dimension time.
+    like : Signal
+        What :func:`signal` read from the input.
+    name : str
+        The DataArray's name.
+    units : str, optional
+        Its ``units`` attribute.
+    dims : tuple of str, optional
+        Its dimensions (default ``("time", "axis")`` for (N, 3), else ``("time", ...)``).
+    coords : dict, optional
+        Extra coordinates.
+    attrs : dict, optional
+        Extra attributes.
+
+    Returns
+    -------
+    xarray.DataArray or numpy.ndarray
+        A DataArray when ``like`` was labelled, else ``values`` unchanged.
     """
     if not like.labelled:
         return values
@@ -471,10 +452,22 @@ def labelled(
 
 
 def output(values, like: Signal, name: str, units: str | None = None, attrs=None):
-    """A per-sample (or scalar) result, labelled exactly when ``like`` was.
+    """Return a per-sample (or scalar) result, labelled exactly when ``like`` was.
 
     Per-sample arrays become DataArrays with the input's ``time`` coordinate and ``fs``
     (:func:`labelled`); a scalar becomes a 0-d DataArray carrying ``units``.
+
+    Parameters
+    ----------
+    values : array_like or float
+        A per-sample array or a single number.
+    like, name, units, attrs
+        As for :func:`labelled`.
+
+    Returns
+    -------
+    xarray.DataArray, numpy.ndarray or float
+        Labelled exactly when ``like`` was, else ``values`` as given.
     """
     if not like.labelled:
         return values
@@ -486,27 +479,49 @@ def output(values, like: Signal, name: str, units: str | None = None, attrs=None
 
 
 def start_time(like: Signal) -> float:
-    """Time (s) of the first sample of a labelled input (0 without a time coordinate)."""
+    """Return the time (s) of the first sample of a labelled input.
+
+    Parameters
+    ----------
+    like : Signal
+        The input.
+
+    Returns
+    -------
+    float
+        The first time, or 0 without a time coordinate.
+    """
     if like.time is not None and like.time.size:
         return float(like.time[0])
     return 0.0
 
 
 def windowed(values, like: Signal, name: str, *, centre_s, fs_out: float, units=None):
-    """One value per window: a DataArray over window-centre times when ``like`` was
-    labelled (``centre_s`` relative to the first sample; ``fs_out`` = windows per s).
+    """Return one value per window, labelled over window-centre times when ``like`` was.
+
+    Parameters
+    ----------
+    values : array_like, shape (K,) or (K, 3)
+        One value per window.
+    like : Signal
+        The input the windows were cut from.
+    name, units
+        As for :func:`labelled`.
+    centre_s : array_like, shape (K,)
+        Window centres (s), relative to the first sample.
+    fs_out : float
+        Windows per second (the output's ``fs``).
+
+    Returns
+    -------
+    xarray.DataArray or numpy.ndarray
+        Over the window centres (absolute times) when ``like`` was labelled.
     """
     if not like.labelled:
         return values
-    values = np.asarray(values)
-    dims = ("time", "axis") if values.ndim == 2 and values.shape[1] == 3 else ("time",)
-    coords = {"time": start_time(like) + np.asarray(centre_s, float)}
-    if "axis" in dims:
-        coords["axis"] = ["x", "y", "z"]
-    attrs = {"fs": float(fs_out)}
-    if units is not None:
-        attrs["units"] = units
-    return xr.DataArray(values, dims=dims, coords=coords, name=name, attrs=attrs)
+    centres = start_time(like) + np.asarray(centre_s, float)
+    per_window = replace(like, time=None, fs=float(fs_out))
+    return labelled(values, per_window, name, units=units, coords={"time": centres})
 
 
 # --------------------------------------------------------------------------- time gaps
@@ -518,7 +533,37 @@ def windowed(values, like: Signal, name: str, *, centre_s, fs_out: float, units=
 # filters) call :func:`segments` and either refuse the recording (error, with
 # :func:`describe_gaps` in the message) or process each segment on its own.
 
-__all__ += ["segments", "describe_gaps"]
+__all__ += ["segments", "describe_gaps", "unknown_keys"]
+
+
+def unknown_keys(given, known, *, hints=None) -> tuple[list[str], str]:
+    """List the keys of ``given`` that are not ``known``, with a hint for each known slip.
+
+    Parameters
+    ----------
+    given : iterable of str
+        Keys (of a mapping, of keyword arguments) as the caller gave them.
+    known : container of str
+        The accepted keys.
+    hints : mapping of str to str, optional
+        For a key that is a common slip, the advice appended when it is among the
+        unknown ones (e.g. ``{"mag": " (pass use_mag=True ...)"}``).
+
+    Returns
+    -------
+    unknown : list of str
+        The unknown keys, in the order given.
+    hint : str
+        The advice for those of them in ``hints``, concatenated (``""`` if none).
+
+    Examples
+    --------
+    >>> unknown_keys(["fs", "files"], {"fs"}, hints={"files": "; read_multi reads it"})
+    (['files'], '; read_multi reads it')
+    """
+    unknown = [k for k in given if k not in known]
+    hint = "".join(text for key, text in (hints or {}).items() if key in unknown)
+    return unknown, hint
 
 
 def _gap_time(time, name: str = "time") -> np.ndarray:
@@ -592,12 +637,26 @@ def segments(time, fs, *, values=None, tolerance: float = 0.5) -> list[tuple[int
 
 
 def describe_gaps(time, fs, segs, *, tolerance: float = 0.5, max_items: int = 5) -> str:
-    """A short sentence describing the gaps around ``segs`` (from :func:`segments`).
+    """Describe in a short sentence the gaps around ``segs`` (from :func:`segments`).
 
     Each gap is given by its duration (time without valid samples, beyond a normal
     step) and the time of its first missing sample, e.g. ``"2 gaps: 1.00 s at t =
     12.30 s (time jump), 0.05 s at t = 20.00 s (5 non-finite samples)"``; at most
-    ``max_items`` are listed. ``"no gaps"`` when ``segs`` covers every sample.
+    ``max_items`` are listed.
+
+    Parameters
+    ----------
+    time, fs, tolerance
+        As for :func:`segments`.
+    segs : list of (int, int)
+        The segments, as :func:`segments` returns them.
+    max_items : int
+        The most gaps listed.
+
+    Returns
+    -------
+    str
+        The sentence; ``"no gaps"`` when ``segs`` covers every sample.
     """
     fs = check_fs(fs)
     tolerance = nonnegative(tolerance, "tolerance")

@@ -1,5 +1,6 @@
-"""The real-data registry: files, checksums and upstream URLs of the public data
-sets the book uses, and loaders returning validated Recordings.
+"""Find, verify and load the public data sets the book uses, as validated Recordings.
+
+The real-data registry holds the files, checksums and upstream URLs of those data sets.
 
 The registry (``_registry/registry.txt``, pooch format) is generated from the data
 manifest by ``tools/make_registry.py`` and committed; the data are not.
@@ -58,7 +59,18 @@ class DataError(RuntimeError):
 
 @functools.cache
 def registry() -> dict[str, dict[str, str]]:
-    """The registry: file name → ``{"sha256", "url", "dataset", "bytes", "license"}``."""
+    """Return the registry of data files, read once from the package.
+
+    Returns
+    -------
+    dict
+        File name → ``{"sha256", "url", "dataset", "bytes", "license"}``.
+
+    Raises
+    ------
+    DataError
+        A malformed registry entry.
+    """
     base = resources.files("tiltlab") / "_registry"
     meta = json.loads((base / "datasets.json").read_text())
     out: dict[str, dict[str, str]] = {}
@@ -116,12 +128,31 @@ def citation(dataset: str) -> str:
 
 
 def data_dir() -> Path | None:
-    """The local mirror named by ``TILTLAB_DATA_DIR``, or None."""
+    """Return the local mirror named by ``TILTLAB_DATA_DIR``.
+
+    Returns
+    -------
+    pathlib.Path or None
+        The resolved folder, or None when the variable is not set.
+    """
     d = os.environ.get(ENV_DATA_DIR)
     return Path(d).expanduser().resolve() if d else None
 
 
-def _sha256(path: Path) -> str:
+def file_sha256(path: str | os.PathLike) -> str:
+    """Return the SHA-256 of a file's content, read in 1 MiB chunks.
+
+    Parameters
+    ----------
+    path : str or path
+        The file.
+
+    Returns
+    -------
+    str
+        The digest, 64 lowercase hexadecimal digits (``bytes.fromhex`` gives the raw
+        digest).
+    """
     h = hashlib.sha256()
     with open(path, "rb") as f:
         for chunk in iter(lambda: f.read(1 << 20), b""):
@@ -131,17 +162,35 @@ def _sha256(path: Path) -> str:
 
 @functools.lru_cache(maxsize=256)
 def _verified(path: str, size: int, mtime_ns: int, expected: str) -> bool:
-    return _sha256(Path(path)) == expected
+    return file_sha256(Path(path)) == expected
 
 
 def verify(path: str | os.PathLike, name: str) -> Path:
-    """Check ``path`` against the registry entry ``name``; return it or raise DataError."""
+    """Check the checksum of ``path`` against the registry entry ``name``.
+
+    Parameters
+    ----------
+    path : str or path
+        A local file.
+    name : str
+        Its registry file name (a key of :func:`registry`).
+
+    Returns
+    -------
+    pathlib.Path
+        ``path``, verified.
+
+    Raises
+    ------
+    DataError
+        A checksum mismatch.
+    """
     path = Path(path)
     entry = registry()[name]
     st = path.stat()
     if not _verified(str(path), st.st_size, st.st_mtime_ns, entry["sha256"]):
         raise DataError(
-            f"checksum mismatch for {name} ({path}): its SHA-256 is {_sha256(path)}, the registry says "
+            f"checksum mismatch for {name} ({path}): its SHA-256 is {file_sha256(path)}, the registry says "
             f"{entry['sha256']}. The file is corrupt, truncated or a different version; delete it "
             "(or repair the mirror) and fetch it again."
         )
@@ -149,8 +198,9 @@ def verify(path: str | os.PathLike, name: str) -> Path:
 
 
 def fetch(name: str, *, progressbar: bool = False) -> Path:
-    """Local path of registered file ``name`` (e.g. ``"broad/02_undisturbed_slow_rotation_B.hdf5"``),
-    checksum verified.
+    """Return the local path of a registered file, checksum verified.
+
+    ``name`` is e.g. ``"broad/02_undisturbed_slow_rotation_B.hdf5"``.
 
     Parameters
     ----------
@@ -215,7 +265,13 @@ _TRIAL = re.compile(r"^broad/(\d{2})_(.+)\.(hdf5|mat)$")
 
 
 def broad_trials() -> dict[int, str]:
-    """Registered BROAD trials: trial number → registry file name (30 of the 39)."""
+    """Return the registered BROAD trials (30 of the 39).
+
+    Returns
+    -------
+    dict of int to str
+        Trial number → registry file name, in increasing order.
+    """
     out = {}
     for name in registry():
         m = _TRIAL.match(name)
@@ -225,7 +281,13 @@ def broad_trials() -> dict[int, str]:
 
 
 def broad_trial_groups() -> dict[int, list[str]]:
-    """Trial number → BROAD's group labels (``undisturbed``, ``rotation``, ``fast`` …), from ``trials.json``."""
+    """Return BROAD's group labels of every registered trial, from ``trials.json``.
+
+    Returns
+    -------
+    dict of int to list of str
+        Trial number → group labels (``undisturbed``, ``rotation``, ``fast`` …).
+    """
     info = json.loads(fetch("broad/trials.json").read_text())["trials"]
     out = {}
     for n, name in broad_trials().items():
@@ -238,8 +300,9 @@ _BROAD_MOTIONS = ("rotation", "translation", "combined")
 
 
 def broad_trial_kind(trial: int, groups: dict[int, list[str]] | None = None) -> str:
-    """The motion of an undisturbed BROAD trial in words: its pace and its kind of
-    motion, e.g. ``"fast rotation"`` or ``"slow translation"``.
+    """Name the motion of an undisturbed BROAD trial: its pace and its kind of motion.
+
+    E.g. ``"fast rotation"`` or ``"slow translation"``.
 
     Parameters
     ----------
@@ -318,12 +381,25 @@ def load_broad_trial(trial: int | str) -> xr.Dataset:
 
 
 def load_fayat_example() -> xr.Dataset:
-    """Fayat et al.'s freely-moving rat head IMU example (100 Hz, g and °/s, no ground truth)."""
+    """Load Fayat et al.'s freely-moving rat head IMU example.
+
+    Returns
+    -------
+    xarray.Dataset
+        The validated Recording: 100 Hz, ``acc`` in g and ``gyr`` in °/s, no ground
+        truth.
+    """
     return io.read_fayat_imu(fetch("fayat2021/example_imu.csv"))
 
 
 def load_fayat_tumble() -> xr.Dataset:
-    """Fayat et al.'s tumble-test recording (300 Hz, sensor still in several orientations)."""
+    """Load Fayat et al.'s tumble-test recording.
+
+    Returns
+    -------
+    xarray.Dataset
+        The validated Recording: 300 Hz, the sensor still in several orientations.
+    """
     return io.read_fayat_tumble(fetch("fayat2021/example_sensor_calibration.csv"))
 
 
@@ -351,6 +427,16 @@ def load(source: str | os.PathLike, **options) -> xr.Dataset:
     ------
     DataError
         If the source is neither a known name nor a readable file type.
+
+    Examples
+    --------
+    The smallest registered recording, read from the mirror named by
+    ``TILTLAB_DATA_DIR`` (or downloaded once into the cache):
+
+    >>> import tiltlab.datasets
+    >>> rec = tiltlab.datasets.load("fayat:example")
+    >>> rec.attrs["fs"], rec.sizes["time"], rec["gyr"].attrs["units"]
+    (100.0, 4893, 'deg/s')
     """
     if not isinstance(source, (str, os.PathLike)):
         raise DataError(
@@ -380,7 +466,7 @@ def load(source: str | os.PathLike, **options) -> xr.Dataset:
 
 
 def source_name(source: str | os.PathLike) -> str:
-    """A data source as a reader sees it: a trial name, or a file name.
+    """Name a data source as a reader sees it: a trial name, or a file name.
 
     Chapters print this in place of the full source, so that a path to a local file
     does not spill the folder it lives in into the book.

@@ -33,7 +33,9 @@ __all__ = ["lowpass", "moving_mean", "moving_std", "still_mask", "window_samples
 def window_samples(
     window_s: float, fs: float, *, minimum: int = 1, name: str = "window_s"
 ) -> int:
-    """Number of samples in a window of ``window_s`` seconds at ``fs`` (rounded, ≥ ``minimum``).
+    """Return the number of samples in a window of ``window_s`` seconds at ``fs``.
+
+    The duration is rounded to the nearest sample, and at least ``minimum``.
 
     Parameters
     ----------
@@ -163,7 +165,7 @@ def still_mask(
     min_duration_s: float = 0.0,
     trim_s: float = 0.0,
 ) -> np.ndarray:
-    r"""The still/rest detector core: samples where a speed stays below a threshold.
+    r"""Find the samples where a speed stays below a threshold: the still/rest detector core.
 
     1. Optionally smooth ``speed`` with a centred ``smooth_s`` moving average.
     2. Candidate samples: smoothed speed ``< threshold`` and, if ``acc_norm`` and

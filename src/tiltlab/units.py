@@ -1,9 +1,11 @@
-"""Physical units used by tiltlab Recordings, conversions between them, and a
-plausibility check that catches a gyroscope whose units are mislabelled.
+"""Name the physical units of tiltlab Recordings and convert between them.
 
-The magnitude checks of values against their unit labels (accelerometer ~1 g, raw ADC
-counts, gyroscope ranges, temperature) and sensor saturation live in
-:mod:`tiltlab.quality`; :func:`tiltlab.schema.validate` runs both.
+What belongs here: the table of accepted units per quantity, their spellings and the
+multiplicative conversions. What does not: any check of values against their unit
+labels (accelerometer ~1 g, raw ADC counts, the gyroscope's °/s-or-rad/s check,
+temperature) and sensor saturation, which live in :mod:`tiltlab.quality`
+(:func:`tiltlab.quality.check_gyr_units` is the one gyroscope-unit check);
+:func:`tiltlab.schema.validate` runs them.
 
 Units travel as strings in the ``units`` attribute of each variable. Only the
 spellings listed in :data:`UNITS` are accepted; aliases are normalised by
@@ -119,7 +121,23 @@ def normalise_unit(unit: str) -> str:
 
 
 def quantity_of(unit: str) -> str:
-    """Name of the physical quantity that ``unit`` measures."""
+    """Return the name of the physical quantity that ``unit`` measures.
+
+    Parameters
+    ----------
+    unit : str
+        A unit (any accepted spelling).
+
+    Returns
+    -------
+    str
+        A key of :data:`UNITS`, e.g. ``"angular_velocity"``.
+
+    Examples
+    --------
+    >>> quantity_of("dps")
+    'angular_velocity'
+    """
     u = normalise_unit(unit)
     for q, us in UNITS.items():
         if u in us:

@@ -1,5 +1,11 @@
 """Data quality: sensor saturation, and whether the values are plausible for their units.
 
+What belongs here: every data-quality finding (saturation, raw counts, values that
+contradict their unit labels, among them the one gyroscope-unit check
+:func:`check_gyr_units`), the :class:`Finding` record and the policy that raises or warns
+them. What does not: what a Recording is (:mod:`tiltlab.schema`), argument checks
+(:mod:`tiltlab._validate`) and unit conversions (:mod:`tiltlab.units`).
+
 Layer 1, beside :mod:`tiltlab.units` and :mod:`tiltlab.schema` (which runs these checks
 in :func:`tiltlab.schema.validate`). Everything here is cheap — medians, percentiles and
 run lengths, O(N) — so that every Recording can be checked when it is built.

@@ -1,5 +1,7 @@
-"""Shared pieces of the quality checks: thresholds, the finding record, the unit-check
-error and the reading of a variable with its units.
+"""Hold the shared pieces of the quality checks.
+
+The thresholds, the finding record, the unit-check error and the reading of a variable
+with its units.
 """
 
 from __future__ import annotations
@@ -77,10 +79,22 @@ class UnitCheckError(RecordingError):
         )
 
     def for_switch(self, switch: str) -> UnitCheckError:
-        """The same error, naming the switch as ``switch`` takes it."""
+        """Return the same error, naming the switch as ``switch`` takes it.
+
+        Parameters
+        ----------
+        switch : str
+            A key of :data:`UNIT_CHECK_SWITCH`.
+
+        Returns
+        -------
+        UnitCheckError
+            The re-worded error.
+        """
         return UnitCheckError(self.findings, switch)
 
-    def __reduce__(self):  # picklable across process pools
+    def __reduce__(self):
+        """Make the error picklable across process pools."""
         return (UnitCheckError, (self.findings, self.switch))
 
 
@@ -111,6 +125,7 @@ class Finding:
 
     @property
     def is_error(self) -> bool:
+        """Whether the finding is an error (else a warning)."""
         return self.severity == "error"
 
 
@@ -133,8 +148,10 @@ def _raw_dtype(x, var: str):
 
 
 def _read(x, name: str, *, units: str | None = None, need_units: bool = True):
-    """Values (2-D, float, NaN kept), canonical units (or None), variable attrs, fs, and
-    whether the input had an integer dtype.
+    """Read a variable with its units, attrs and sampling rate.
+
+    Returns the values (2-D, float, NaN kept), the canonical units (or None), the
+    variable's attrs, fs, and whether the input had an integer dtype.
     """
     kind = _raw_dtype(x, name).kind
     if isinstance(x, xr.Dataset):

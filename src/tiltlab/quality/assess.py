@@ -1,4 +1,4 @@
-"""Every finding of a Recording, and the policy: errors raised, the rest warned."""
+"""Collect every finding of a Recording, and apply the policy: errors raised, the rest warned."""
 
 from __future__ import annotations
 
@@ -9,6 +9,7 @@ from collections.abc import Sequence
 
 import xarray as xr
 
+from .._deprecate import renamed
 from ._common import (
     Finding,
     QualityWarning,
@@ -26,51 +27,79 @@ from .unitcheck import (
 )
 
 
-def plausibility(ds: xr.Dataset) -> list[Finding]:
-    """Every plausibility finding of a Recording: raw counts, accelerometer and gyroscope
-    units, temperature (see the ``check_*`` functions). NaN samples are ignored.
+@renamed(ds="rec")
+def plausibility(rec: xr.Dataset) -> list[Finding]:
+    """Return every plausibility finding of a Recording's values against their units.
+
+    Raw counts, accelerometer and gyroscope units, temperature (see the ``check_*``
+    functions); a variable found to hold raw counts is not checked further. NaN samples
+    are ignored.
+
+    Parameters
+    ----------
+    rec : xarray.Dataset
+        A Recording (``ds`` is its old name).
+
+    Returns
+    -------
+    list of Finding
+        Errors and warnings, in the order of the checks.
     """
     out: list[Finding] = []
     counts = set()
     for name in _VECTORS:
-        if name in ds:
-            f = check_raw_counts(ds, var=name)
+        if name in rec:
+            f = check_raw_counts(rec, var=name)
             if f is not None:
                 out.append(f)
                 counts.add(name)
-    if "acc" in ds and "acc" not in counts:
-        f = check_acc_units(ds, var="acc")
+    if "acc" in rec and "acc" not in counts:
+        f = check_acc_units(rec, var="acc")
         if f is not None:
             out.append(f)
-    if "gyr" in ds and "gyr" not in counts:
-        f = check_gyr_units(ds, var="gyr")
+    if "gyr" in rec and "gyr" not in counts:
+        f = check_gyr_units(rec, var="gyr")
         if f is not None:
             out.append(f)
-    if "temp" in ds:
-        f = check_temperature(ds, var="temp")
+    if "temp" in rec:
+        f = check_temperature(rec, var="temp")
         if f is not None:
             out.append(f)
     return out
 
 
+@renamed(ds="rec")
 def assess(
-    ds: xr.Dataset, *, units: bool = True, saturation: bool = True
+    rec: xr.Dataset, *, units: bool = True, saturation: bool = True
 ) -> list[Finding]:
-    """All quality findings of a Recording (plausibility, then saturation), without
-    raising or warning. ``units`` / ``saturation`` select the checks.
+    """Return all quality findings of a Recording, without raising or warning.
+
+    Parameters
+    ----------
+    rec : xarray.Dataset
+        A Recording (``ds`` is its old name).
+    units : bool
+        Include the plausibility of the values against their units
+        (:func:`plausibility`).
+    saturation : bool
+        Include clipped samples and stale full scales
+        (:func:`~tiltlab.quality.check_saturation`).
+
+    Returns
+    -------
+    list of Finding
+        The plausibility findings, then the saturation ones.
     """
     out: list[Finding] = []
     if units:
-        out += plausibility(ds)
+        out += plausibility(rec)
     if saturation:
-        out += check_saturation(ds)
+        out += check_saturation(rec)
     return out
 
 
 def _stacklevel() -> int:
-    """The stack level of the first caller outside tiltlab, for :func:`warnings.warn`
-    called from :func:`emit`.
-    """
+    """Return the stack level of the first caller outside tiltlab, for :func:`emit`."""
     pkg = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))  # tiltlab
     frame = sys._getframe(1)  # emit
     level = 1
@@ -83,8 +112,18 @@ def _stacklevel() -> int:
 
 
 def emit(findings: Sequence[Finding]) -> None:
-    """Raise :class:`RecordingError` with every error's message (joined by ``"; "``),
-    else warn each warning as a :class:`QualityWarning`.
+    """Raise the error findings, else warn each warning as a :class:`QualityWarning`.
+
+    Parameters
+    ----------
+    findings : sequence of Finding
+        As returned by :func:`assess`.
+
+    Raises
+    ------
+    UnitCheckError
+        (a :class:`~tiltlab.RecordingError`) When a finding is an error; its message
+        joins every error's message.
     """
     errors = [f for f in findings if f.is_error]
     if errors:

@@ -1,4 +1,4 @@
-"""Sensor saturation (clipped samples at the full scale) and raw ADC counts."""
+"""Find sensor saturation (clipped samples at the full scale) and raw ADC counts."""
 
 from __future__ import annotations
 
@@ -8,6 +8,7 @@ import xarray as xr
 
 from .. import _validate
 from .. import units as _units
+from .._deprecate import renamed
 from .._validate import RecordingError
 from ._common import (
     Finding,
@@ -22,11 +23,27 @@ from ._common import (
 
 
 def full_scale(attrs_or_da, name: str = "the variable") -> tuple[float, float] | None:
-    """The full scale recorded in a variable's ``range`` attribute, as ``(low, high)``.
+    """Return the full scale recorded in a variable's ``range`` attribute.
 
     ``range`` is the sensor's measurement range in the variable's units: a positive number
-    ``r`` (meaning ±r) or a pair ``[low, high]`` with ``low < 0 < high``. Returns None
-    when there is no such attribute; a malformed one is a :class:`RecordingError`.
+    ``r`` (meaning ±r) or a pair ``[low, high]`` with ``low < 0 < high``.
+
+    Parameters
+    ----------
+    attrs_or_da : mapping, xarray.DataArray or xarray.Dataset
+        The attributes, or the variable carrying them.
+    name : str
+        The variable's name, used in messages.
+
+    Returns
+    -------
+    (float, float) or None
+        ``(low, high)``, or None when there is no ``range`` attribute.
+
+    Raises
+    ------
+    RecordingError
+        A malformed ``range`` attribute.
     """
     attrs = (
         attrs_or_da.attrs
@@ -39,8 +56,21 @@ def full_scale(attrs_or_da, name: str = "the variable") -> tuple[float, float] |
 
 
 def limits(value, what: str = "limit", error=ValueError) -> tuple[float, float]:
-    """A full scale as ``(low, high)``: ``r`` (a positive number) means ±r, a pair must
-    have ``low < 0 < high``; anything else raises ``error`` naming ``what``.
+    """Return a full scale as ``(low, high)``.
+
+    Parameters
+    ----------
+    value : float or (float, float)
+        ``r`` (a positive number) meaning ±r, or a pair with ``low < 0 < high``.
+    what : str
+        Its name, used in messages.
+    error : type of Exception
+        The exception raised for anything else (naming ``what``).
+
+    Returns
+    -------
+    (float, float)
+        ``(low, high)``.
     """
     bad = error(
         f"{what} must be a positive full scale r (for ±r) or [low, high] with "
@@ -66,7 +96,7 @@ def _run_lengths(flags: np.ndarray) -> np.ndarray:
 
 
 def _observed_rail(v: np.ndarray, min_run: int) -> float | None:
-    """The largest |value| if it behaves like a rail the signal is clipped at, else None."""
+    """Return the largest |value| if it behaves like a rail the signal is clipped at."""
     a = np.abs(v)
     finite = np.isfinite(a)
     if not finite.any():
@@ -101,9 +131,11 @@ def _observed_rail(v: np.ndarray, min_run: int) -> float | None:
 
 
 def _repeat_rate(col: np.ndarray, top: np.ndarray, near: np.ndarray) -> float:
-    """How often the signal repeats its previous value: on consecutive samples just below
-    the maximum (``near`` and not ``top``) when there are at least 10 such pairs, else on
-    the whole axis outside the maximum (a sample-and-hold signal repeats everywhere).
+    """Return how often the signal repeats its previous value.
+
+    Counted on consecutive samples just below the maximum (``near`` and not ``top``)
+    when there are at least 10 such pairs, else on the whole axis outside the maximum (a
+    sample-and-hold signal repeats everywhere).
     """
     for sel in (near & ~top, ~top):
         pair = sel[1:] & sel[:-1] & np.isfinite(col[1:]) & np.isfinite(col[:-1])
@@ -220,8 +252,10 @@ def saturation(
 
 
 def _attr_limit(v: np.ndarray, attrs, name: str):
-    """The full scale of the ``range`` attribute, or None when absent or stale (the data
-    exceed it by more than 5 %); and the peak |value| when stale, else None.
+    """Return the full scale of the ``range`` attribute and the peak when it is stale.
+
+    The full scale is None when absent or stale (the data exceed it by more than 5 %);
+    the peak |value| is given when stale, else None.
     """
     lim = full_scale(attrs, repr(name))
     if lim is None:
@@ -232,23 +266,37 @@ def _attr_limit(v: np.ndarray, attrs, name: str):
     return lim, None
 
 
+@renamed(ds="rec")
 def check_saturation(
-    ds: xr.Dataset, *, fraction: float = 0.999, min_run: int = 3
+    rec: xr.Dataset, *, fraction: float = 0.999, min_run: int = 3
 ) -> list[Finding]:
-    """Warnings about clipped samples of ``acc``, ``gyr`` and ``mag`` (see
-    :func:`saturation`), and about a ``range`` attribute the data exceed by more than 5 %
-    (a stale or wrong full scale, e.g. after a change of units).
+    """Return warnings about clipped samples and stale full scales of a Recording.
 
-    Saturation is a warning, never an error: the Recording is still valid and the clipped
-    samples are known (mask them with :func:`saturation`).
+    Clipped samples of ``acc``, ``gyr`` and ``mag`` (see :func:`saturation`), and a
+    ``range`` attribute the data exceed by more than 5 % (a stale or wrong full scale,
+    e.g. after a change of units). Saturation is a warning, never an error: the
+    Recording is still valid and the clipped samples are known (mask them with
+    :func:`saturation`).
+
+    Parameters
+    ----------
+    rec : xarray.Dataset
+        A Recording (``ds`` is its old name).
+    fraction, min_run
+        As for :func:`saturation`.
+
+    Returns
+    -------
+    list of Finding
+        One warning per variable with clipped samples or a stale ``range``.
     """
     frac = _validate.fraction(fraction, "fraction", open_low=True)
     min_run = _validate.integer(min_run, "min_run", minimum=1)
     out: list[Finding] = []
     for name in _VECTORS:
-        if name not in ds:
+        if name not in rec:
             continue
-        v, u, attrs, _, _ = _read(ds, name, need_units=False)
+        v, u, attrs, _, _ = _read(rec, name, need_units=False)
         unit = f" {_u(u)}" if u else ""
         lim, stale = _attr_limit(v, attrs, name)
         if stale is not None:
@@ -317,6 +365,11 @@ def check_raw_counts(
         Units of a plain array.
     var : {"acc", "gyr", "mag"}
         Which quantity (default the DataArray's name).
+
+    Returns
+    -------
+    Finding or None
+        An error finding, or None when the values are within a physical range.
     """
     name = _name(x, var)
     if name not in _PHYSICAL:

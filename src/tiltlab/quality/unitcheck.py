@@ -1,5 +1,8 @@
-"""Are the values plausible for their unit labels? Accelerometer, gyroscope and
-temperature checks (the gyroscope against the tilt the accelerometer sees).
+"""Check that values are plausible for their unit labels: accelerometer, gyroscope, temperature.
+
+The gyroscope is judged against the tilt the accelerometer sees: :func:`check_gyr_units`
+is tiltlab's one gyroscope-unit check, used by :func:`tiltlab.schema.validate` (through
+:func:`tiltlab.quality.plausibility`) and by every reader.
 """
 
 from __future__ import annotations
@@ -39,9 +42,19 @@ def check_acc_units(acc, units: str | None = None, *, var: str = "acc"):
     magnitude (a gravity-free "linear acceleration" signal, whose median in m/s² can be
     about 1), the finding is only a warning.
 
+    Parameters
+    ----------
+    acc : xarray.Dataset, xarray.DataArray or array_like, shape (N, 3)
+        A Recording (its ``fs`` is then used), a labelled DataArray or a plain array.
+    units : str, optional
+        Units of a plain array.
+    var : str
+        The variable of a Recording (default ``"acc"``).
+
     Returns
     -------
     Finding or None
+        An error or a warning, or None when the magnitude is plausible.
     """
     name = _name(acc, var)
     v, u, _, fs, _ = _read(acc, name, units=units)
@@ -92,8 +105,9 @@ def check_acc_units(acc, units: str | None = None, *, var: str = "acc"):
 def _smoothed_directions(
     acc: np.ndarray, w: int, tol: float
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Unit directions of the acceleration averaged over ``w`` samples (centred), and
-    whether each is gravity-dominated (its magnitude within ``tol`` of the median).
+    """Return the directions of the acceleration averaged over ``w`` samples (centred).
+
+    Also whether each is gravity-dominated (its magnitude within ``tol`` of the median).
     """
     a = np.where(np.isfinite(acc), acc, 0.0)
     c = np.cumsum(np.vstack([np.zeros((1, 3)), a]), axis=0)
@@ -121,9 +135,11 @@ GYR_DECISIVE_SHARE: float = 0.6
 def _rotation_bound(
     gyr_rad_s: np.ndarray, acc: np.ndarray, fs: float
 ) -> tuple[int, int, float]:
-    """Windows in which the accelerometer turns by more than ``GYR_MIN_TILT_DEG``, and
-    how many of them the gyroscope cannot explain (it integrates to less than a fifth
-    of that tilt), and the median |cosine| between the axis the accelerometer turns
+    """Count the windows whose tilt the gyroscope cannot explain.
+
+    Returns the windows in which the accelerometer turns by more than
+    ``GYR_MIN_TILT_DEG``, how many of them the gyroscope cannot explain (it integrates
+    to less than a fifth of that tilt), and the median |cosine| between the axis the accelerometer turns
     about and the gyroscope's (perpendicular to gravity) in those windows: the |median
     signed cosine|. The angle between two gravity directions is at most the rotation
     integrated between them, so a correctly labelled gyroscope explains every window,
@@ -210,10 +226,13 @@ def check_gyr_units(
         Acceleration (any units) for the °/s case.
     fs : float, optional
         Sampling rate (Hz) for the °/s case.
+    var : str
+        The variable of a Recording (default ``"gyr"``).
 
     Returns
     -------
     Finding or None
+        An error or a warning, or None when the label is plausible or undecidable.
     """
     name = _name(gyr, var)
     v, u, _, f, _ = _read(gyr, name, units=units)
@@ -298,8 +317,9 @@ def check_gyr_units(
 
 
 def _tilt_span(acc: np.ndarray, fs: float) -> float | None:
-    """A lower bound (rad) of how far the gravity direction seen by the accelerometer
-    turns: the angle between two of its directions, smoothed over 0.5 s and taken on
+    """Return a lower bound (rad) of how far the accelerometer's gravity direction turns.
+
+    It is the angle between two of its directions, smoothed over 0.5 s and taken on
     samples whose magnitude is within 10 % of the median (gravity-dominated).
     """
     a = _finite_rows(acc)
@@ -328,6 +348,20 @@ def check_temperature(temp, units: str | None = None, *, var: str = "temp"):
     with every value in −40…85, the unit is swapped: an **error** (it shifts every
     temperature correction by 273.15). Other values outside the range are a **warning**
     (a sensor outside its rated range, or a bad channel).
+
+    Parameters
+    ----------
+    temp : xarray.Dataset, xarray.DataArray or array_like, shape (N,)
+        Temperatures: a Recording's ``var``, a labelled DataArray or a plain array.
+    units : {"degC", "K"}, optional
+        Needed for a plain array (labelled input carries its own).
+    var : str
+        Which variable of a Recording holds them (default ``"temp"``).
+
+    Returns
+    -------
+    Finding or None
+        None when every value is in the operating range.
     """
     name = _name(temp, var)
     v, u, _, _, _ = _read(temp, name, units=units, need_units=True)
