@@ -67,7 +67,7 @@ def test_kde_of_many_samples_and_mkde_integrate_to_one(grid, h):
     )
     w = rng.random(len(x))
     assert S.kde(x, grid=grid, h=h, weights=w).integral() == pytest.approx(1, abs=1e-9)
-    walk = S.slerp(POLE_N, [1.0, 0, 0], np.linspace(0, 1, 40))
+    walk = S.slerp_vectors(POLE_N, [1.0, 0, 0], np.linspace(0, 1, 40))
     assert S.mkde(walk, fs=10.0, grid=grid, h=h).integral() == pytest.approx(
         1, abs=1e-9
     )
@@ -190,8 +190,8 @@ ZERO_DIRECTION = {
     "grid_for/vectors": lambda: S.grid_for(np.zeros((4, 3))),
     "tilt_map/vectors": lambda: S.tilt_map(np.r_[_X, [[0.0, 0, 0]]]),
     "histogram/vectors": lambda: S.histogram(np.zeros((4, 3)), S.sphere_mesh(100)),
-    "slerp/a": lambda: S.slerp([0.0, 0, 0], [1.0, 0, 0], 0.5),
-    "slerp/b": lambda: S.slerp([1.0, 0, 0], [0.0, 0, 0], 0.5),
+    "slerp/a": lambda: S.slerp_vectors([0.0, 0, 0], [1.0, 0, 0], 0.5),
+    "slerp/b": lambda: S.slerp_vectors([1.0, 0, 0], [0.0, 0, 0], 0.5),
     "angle/u": lambda: S.angle([0.0, 0, 0], [1.0, 0, 0]),
     "angle/v": lambda: S.angle([1.0, 0, 0], [0.0, 0, 0]),
     "equal_area_grid/pole": lambda: S.equal_area_grid(5.0, pole=(0.0, 0, 0)),
@@ -477,15 +477,18 @@ def test_zero_vector_posture_is_nan_with_a_warning(func):
     assert np.all(np.isnan(out[:, 1])) and np.all(np.isfinite(out[:, [0, 2]]))
 
 
-def test_non_unit_quaternions_are_normalised_with_a_warning():
+def test_non_unit_quaternions_are_refused_naming_q():
     rng = np.random.default_rng(4)
     q = tq.random_quaternions(6, rng)
     ref = T.angles_from_quaternion(q)
-    with pytest.warns(RuntimeWarning, match=r"\bq\b.*not unit.*normalised"):
-        o = T.angles_from_quaternion(q * np.array([2.0, 1, 0.5, 1, 1, 3])[:, None])
+    with pytest.raises(ValueError, match=r"\bq\b.*unit.*normalise them first"):
+        T.angles_from_quaternion(q * np.array([2.0, 1, 0.5, 1, 1, 3])[:, None])
+    # normalised explicitly, they give the angles of the unit quaternions
+    o = T.angles_from_quaternion(tq.normalize(q * 3.0))
     np.testing.assert_allclose(np.asarray(o), np.asarray(ref), atol=1e-12)
-    # within 1e-6: no warning
-    _no_warnings(lambda: T.angles_from_quaternion(q * (1 + 5e-7)))
+    # within 1e-6: accepted, no warning
+    o = _no_warnings(lambda: T.angles_from_quaternion(q * (1 + 5e-7)))
+    np.testing.assert_allclose(np.asarray(o), np.asarray(ref), atol=1e-12)
     # NaN rows (gaps) give NaN angles
     qn = q.copy()
     qn[2] = NAN
@@ -545,7 +548,7 @@ def test_reflection_in_a_stack_of_rotations_is_refused():
 # ---------------------------------------------------------------------------
 
 _G = S.vmf_sample([0, 0, 1.0], 20, 60, rng=8)
-_WALK = S.slerp(POLE_N, [1.0, 0, 0], np.linspace(0, 1, 30))
+_WALK = S.slerp_vectors(POLE_N, [1.0, 0, 0], np.linspace(0, 1, 30))
 _ACC = np.tile([0.0, 0, 1], (4, 1))
 _MAG = np.tile([0.0, 30, -40], (4, 1))
 
@@ -631,7 +634,7 @@ PARAMETERS = [
         "level",
         r"nan",
     ),
-    ("slerp-t-nan", lambda: S.slerp(POLE_N, [1.0, 0, 0], NAN), "t", None),
+    ("slerp-t-nan", lambda: S.slerp_vectors(POLE_N, [1.0, 0, 0], NAN), "t", None),
     ("sphere_mesh-n-small", lambda: S.sphere_mesh(3), "n", r"3"),
     ("sphere_mesh-n-float", lambda: S.sphere_mesh(100.5), "n", r"100\.5"),
     (

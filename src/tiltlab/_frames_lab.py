@@ -1,8 +1,11 @@
-r"""Tumble stage, Fibonacci lattice and marker head frame (private part of :mod:`tiltlab.frames`).
+r"""Geomagnetic field, tumble stage, Fibonacci lattice and marker head frame.
+
+The private part of :mod:`tiltlab.frames`.
 
 Everything here is re-exported by :mod:`tiltlab.frames`, where it is documented and
 imported from; this module imports nothing from it (the dependency runs one way). It
-also holds the small input checks that :mod:`tiltlab.frames` shares.
+also holds the small input checks and labelling helpers that :mod:`tiltlab.frames` and
+:mod:`tiltlab.trig` share.
 
 References
 ----------
@@ -14,10 +17,13 @@ References
 from __future__ import annotations
 
 import numpy as np
+import xarray as xr
 
-from . import quaternion as _quat
+import tiltlab._validate as _v
+import tiltlab.quaternion as _quat
 
 __all__ = [
+    "geomagnetic_field",
     "fibonacci_lattice",
     "stage_angles",
     "stage_quaternion",
@@ -37,15 +43,42 @@ def _vec3(a, name: str) -> np.ndarray:
 
 
 def _angle(a, name: str) -> np.ndarray:
-    """Angles (rad) as floats; NaN (undefined) passes, an infinite angle raises."""
-    a = np.asarray(a, dtype=float)
-    if np.any(np.isinf(a)):
-        raise ValueError(f"{name} has {int(np.sum(np.isinf(a)))} infinite values")
+    """Angles (rad) as a float copy; NaN (undefined) passes, ±inf or complex raise."""
+    return _v.vectors(a, name, width=None, ndim=None, allow_nan=True)
+
+
+RAD_UNITS = ("rad", "radian", "radians", "1", "")  # SI: rad = 1
+DEG_UNITS = ("deg", "degree", "degrees", "°")
+
+
+def _angle_units(da: xr.DataArray, name: str) -> str:
+    """``"rad"`` or ``"deg"``: the angle units of ``da`` (none means rad), else raise."""
+    units = da.attrs.get("units")
+    key = "rad" if units is None else str(units).strip().lower()
+    if key in RAD_UNITS:
+        return "rad"
+    if key in DEG_UNITS:
+        return "deg"
+    raise ValueError(f"{name} must be an angle in rad (or deg), got units {units!r}")
+
+
+def _label_attrs(da: xr.DataArray, units, attrs=None) -> dict:
+    """Return the attributes of an output derived from ``da``: its ``fs``, ``method``, ``units``."""
+    a = {k: da.attrs[k] for k in ("fs", "method") if k in da.attrs}
+    if units is not None:
+        a["units"] = units
+    a.update(attrs or {})
     return a
 
 
+def _label_as(values, da: xr.DataArray, name: str, units, attrs=None) -> xr.DataArray:
+    """``values`` (shaped like ``da``) with its dims and coords, ``fs`` and ``method``."""
+    a = _label_attrs(da, units, attrs)
+    return xr.DataArray(values, dims=da.dims, coords=da.coords, name=name, attrs=a)
+
+
 def _nonzero(a: np.ndarray, name: str, what: str = "vector") -> np.ndarray:
-    """``a`` (…, 3) unchanged; a zero (finite) vector, which has no direction, raises."""
+    """Return ``a`` (…, 3) unchanged; raise on a zero (finite) vector, which has no direction."""
     n = np.linalg.norm(a, axis=-1)
     if np.any(n == 0):
         k = int(np.sum(n == 0))
@@ -53,6 +86,49 @@ def _nonzero(a: np.ndarray, name: str, what: str = "vector") -> np.ndarray:
             f"{name} has {k} zero {what}{'s' if k > 1 else ''}: its direction is undefined"
         )
     return a
+
+
+# ---------------------------------------------------------------------------
+# the Earth's magnetic field (Benhamou §1)
+# ---------------------------------------------------------------------------
+
+
+def geomagnetic_field(
+    intensity: float = 48.0,
+    inclination: float = np.radians(64.0),
+    declination: float = 0.0,
+) -> np.ndarray:
+    r"""Geomagnetic field in ENU coordinates.
+
+    ``inclination`` is the dip angle, positive *downwards* (northern hemisphere),
+    ``declination`` is positive East of true North:
+    :math:`B(\cos I\sin D, \cos I\cos D, -\sin I)`.
+
+    Parameters
+    ----------
+    intensity : float, optional
+        Total field intensity (> 0), in the unit wanted for the output; default 48.0
+        (µT).
+    inclination : float, optional
+        Dip angle I in rad, positive downwards; default 64° (in rad).
+    declination : float, optional
+        Declination D in rad, positive East of true North; default 0.
+
+    Returns
+    -------
+    numpy.ndarray, shape (3,)
+        Field (East, North, Up) in the unit of ``intensity``.
+    """
+    intensity = _v.positive(intensity, "intensity")
+    inclination = _v.finite(inclination, "inclination")
+    declination = _v.finite(declination, "declination")
+    return intensity * np.array(
+        [
+            np.cos(inclination) * np.sin(declination),
+            np.cos(inclination) * np.cos(declination),
+            -np.sin(inclination),
+        ]
+    )
 
 
 # ---------------------------------------------------------------------------
@@ -142,8 +218,10 @@ def stage_quaternion(pitch, roll) -> np.ndarray:
 
 
 def head_frame_from_markers(m1, m2, m3) -> np.ndarray:
-    r"""Head frame of Fayat §2.6.4 from markers 1–3: rotation matrices (..., 3, 3) whose
-    columns are :math:`h_x, h_y, h_z` in mocap (world) coordinates.
+    r"""Compute the head frame of Fayat §2.6.4 from markers 1–3.
+
+    The head frame is given as rotation matrices (..., 3, 3) whose columns are
+    :math:`h_x, h_y, h_z` in mocap (world) coordinates.
 
     :math:`h_y = (m_1 - m_2)/\|\cdot\|`, :math:`h_z = (m_3 - m_2) \times h_y / \|\cdot\|`,
     :math:`h_x = h_y \times h_z`.

@@ -96,7 +96,7 @@ PRESETS: dict[str, Preset] = {
 
 
 def parse_axes(spec: Sequence[str], where: str = "axes") -> np.ndarray:
-    """A signed permutation matrix ``P`` from an axes specification.
+    """Build a signed permutation matrix ``P`` from an axes specification.
 
     ``sensor = P @ device``: row ``i`` of ``P`` picks (with its sign) the device axis
     that sensor axis ``i`` is.
@@ -282,8 +282,9 @@ def _describe(m: np.ndarray) -> str:
 
 
 def axis_labels(obj: Any) -> list[str]:
-    """The axis labels of a Recording or labelled DataArray (``attrs['axis_labels']``),
-    or ``["x", "y", "z"]`` when none are recorded.
+    """Return the axis labels of a Recording or labelled DataArray.
+
+    These are ``attrs['axis_labels']``, or ``["x", "y", "z"]`` when none are recorded.
 
     Parameters
     ----------

@@ -23,6 +23,10 @@ Inputs are checked (:class:`ValueError` naming the argument): NaN angles and vec
 (missing samples) propagate, but infinite angles, zero vectors where a direction is
 needed (``acc_rest``, ``g``), coincident or collinear markers, non-unit quaternions and
 matrices that are not rotations (reflections included) are errors.
+:func:`wrap_angle`, :func:`angles_from_quaternion` and :func:`angles_from_matrix`
+also take labelled DataArrays (e.g. the ``q`` of :func:`tiltlab.filters.estimate`) and
+then return DataArrays with their ``time`` coordinate and ``fs``; :mod:`tiltlab.trig`
+re-exports them (the same objects).
 
 References
 ----------
@@ -38,14 +42,19 @@ from __future__ import annotations
 from typing import Literal, NamedTuple
 
 import numpy as np
+import xarray as xr
 
-from . import _validate as _v
-from . import quaternion as _quat
+import tiltlab._validate as _v
+import tiltlab.quaternion as _quat
+
 from ._frames_lab import (
     _angle,
+    _angle_units,
+    _label_as,
     _nonzero,
     _vec3,
     fibonacci_lattice,
+    geomagnetic_field,
     head_frame_from_markers,
     stage_angles,
     stage_quaternion,
@@ -111,22 +120,51 @@ def _clip1(x):
     return np.clip(x, -1.0, 1.0)
 
 
-def wrap_angle(angle) -> np.ndarray:
+def _wrap(a: np.ndarray) -> np.ndarray:
+    w = np.mod(a + np.pi, 2 * np.pi) - np.pi
+    return np.where(w == -np.pi, np.pi, w)
+
+
+def wrap_angle(angle):
     """Wrap angles (rad) to (−π, π].
+
+    A DataArray gives a DataArray with the same dims, coordinates, attributes and name;
+    one in degrees (``attrs["units"] == "deg"``) is wrapped to (−180, 180]. Anything
+    else gives an ndarray. NaN (a missing sample) stays NaN.
 
     Parameters
     ----------
-    angle : array_like
-        Angles in rad, any shape; NaN propagates, infinite values raise.
+    angle : float, array_like or xarray.DataArray
+        Angles in rad, any shape (a DataArray may be in degrees).
 
     Returns
     -------
-    numpy.ndarray
-        The equivalent angles in rad, in (−π, π], with the shape of ``angle``.
+    numpy.ndarray or xarray.DataArray
+        The equivalent angles in (−π, π] (or (−180°, 180°]), in the input's units and
+        shape.
+
+    Raises
+    ------
+    ValueError
+        If ``angle`` is not numeric, holds ±inf, or is a DataArray with units other
+        than rad or deg.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from tiltlab import trig
+    >>> np.round(trig.wrap_angle([3 * np.pi / 2, -np.pi, 0.5]), 3)
+    array([-1.571,  3.142,  0.5  ])
     """
-    a = _angle(angle, "angle")
-    w = np.mod(a + np.pi, 2 * np.pi) - np.pi
-    return np.where(w == -np.pi, np.pi, w)
+    if not isinstance(angle, xr.DataArray):
+        return _wrap(_angle(angle, "angle"))
+    v = _angle(angle.values, "angle")
+    w = (
+        _wrap(v)
+        if _angle_units(angle, "angle") == "rad"
+        else np.degrees(_wrap(np.radians(v)))
+    )
+    return angle.copy(data=w)
 
 
 # ---------------------------------------------------------------------------
@@ -175,12 +213,12 @@ def R2(angle) -> np.ndarray:
     Parameters
     ----------
     angle : array_like, shape (...)
-        Rotation angles in rad; finite (NaN propagates).
+        Elevation-like angles in rad (positive raises the first axis), as for :func:`R1`.
 
     Returns
     -------
     numpy.ndarray, shape (..., 3, 3)
-        Rotation matrices, one per angle.
+        Clockwise rotations about the second axis, one per angle.
     """
     return _rot(angle, 0, 2, 1.0)
 
@@ -191,12 +229,12 @@ def R3(angle) -> np.ndarray:
     Parameters
     ----------
     angle : array_like, shape (...)
-        Rotation angles in rad; finite (NaN propagates).
+        Azimuth-like angles in rad (counter-clockwise seen from above), as for :func:`R1`.
 
     Returns
     -------
     numpy.ndarray, shape (..., 3, 3)
-        Rotation matrices, one per angle.
+        Counter-clockwise rotations about the third axis, one per angle.
     """
     return _rot(angle, 0, 1, 1.0)
 
@@ -216,6 +254,13 @@ def unit_vector(xi, psi) -> np.ndarray:
     -------
     numpy.ndarray, shape (..., 3)
         Unit vectors, with the broadcast shape of ``xi`` and ``psi`` plus a last axis.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from tiltlab import trig
+    >>> np.round(trig.unit_vector(0.0, np.radians(45)), 3)
+    array([0.707, 0.   , 0.707])
     """
     xi, psi = np.broadcast_arrays(_angle(xi, "xi"), _angle(psi, "psi"))
     return np.stack(
@@ -338,8 +383,30 @@ def angles_to_matrix(azimuth, elevation, bank) -> np.ndarray:
     return R3(azimuth) @ R2(elevation) @ R1(bank)
 
 
+def _orientation(C: np.ndarray, singular_tol: float) -> Orientation:
+    """Azimuth, elevation and bank of checked rotation matrices ``C`` (..., 3, 3)."""
+    h = np.hypot(C[..., 0, 0], C[..., 1, 0])
+    el = np.arctan2(C[..., 2, 0], h)
+    az = np.arctan2(C[..., 1, 0], C[..., 0, 0])
+    bk = np.arctan2(C[..., 2, 1], C[..., 2, 2])
+    with np.errstate(invalid="ignore"):  # NaN matrices (missing samples)
+        sing = h < singular_tol
+    az = np.where(sing, _wrap(np.arctan2(C[..., 1, 1], C[..., 0, 1]) - np.pi / 2), az)
+    return Orientation(az, el, np.where(sing, 0.0, bk))
+
+
+def _labelled_orientation(o: Orientation, da, drop) -> Orientation:
+    """``o`` as DataArrays labelled like ``da`` without its ``drop`` dimensions."""
+    if da is None:
+        return o
+    tmpl = da.isel({d: 0 for d in drop}, drop=True)
+    return Orientation(
+        *(_label_as(v, tmpl, n, "rad") for v, n in zip(o, o._fields, strict=True))
+    )
+
+
 def angles_from_matrix(matrix, singular_tol: float = 1e-9) -> Orientation:
-    r"""Azimuth, elevation and bank from body→world rotation matrices.
+    r"""Compute azimuth, elevation and bank (rad) from body→world rotation matrices.
 
     :math:`\theta=\mathrm{atan2}(C_{10},C_{00})`, :math:`\phi=\mathrm{atan2}(C_{20},\sqrt{C_{00}^2+C_{10}^2})`,
     :math:`\lambda=\mathrm{atan2}(C_{21},C_{22})`.
@@ -349,9 +416,14 @@ def angles_from_matrix(matrix, singular_tol: float = 1e-9) -> Orientation:
     pseudo-bank is λ = 0 and the pseudo-azimuth θ = θ' − π/2 with θ' the azimuth of
     the sway axis, which represents the same rotation exactly.
 
+    ``matrix`` must hold proper rotations: reflections (det −1), non-orthonormal
+    matrices and ±inf are errors naming it; NaN matrices (missing samples) give NaN. A
+    DataArray whose last two dims are the 3 × 3 matrix gives DataArrays with its other
+    coordinates (``time``) and ``fs``.
+
     Parameters
     ----------
-    matrix : array_like, shape (..., 3, 3)
+    matrix : array_like, shape (..., 3, 3), or xarray.DataArray
         Body → world rotation matrices (orthonormal within 1e-6, determinant +1).
     singular_tol : float, optional
         Threshold (≥ 0) on cos φ below which the configuration is treated as singular
@@ -361,23 +433,31 @@ def angles_from_matrix(matrix, singular_tol: float = 1e-9) -> Orientation:
     -------
     Orientation
         Named tuple ``(azimuth, elevation, bank)`` of arrays of shape (...), in rad:
-        azimuth θ and bank λ in (−π, π], elevation φ in [−π/2, π/2].
+        azimuth θ and bank λ in (−π, π], elevation φ in [−π/2, π/2]; DataArrays for
+        DataArray input.
+
+    Raises
+    ------
+    ValueError
+        If ``matrix`` has a wrong shape, is not numeric, holds ±inf or is not a proper
+        rotation, or ``singular_tol`` is negative or NaN.
     """
-    C = np.asarray(matrix, dtype=float)
-    if C.shape[-2:] != (3, 3):
-        raise ValueError(f"matrix must have shape (..., 3, 3), got {C.shape}")
     singular_tol = _v.nonnegative(singular_tol, "singular_tol")
+    da = None
+    if isinstance(matrix, xr.DataArray):
+        if matrix.ndim < 2:
+            raise ValueError(
+                f"matrix must have shape (..., 3, 3), got dims {matrix.dims}"
+            )
+        da = matrix.transpose("time", ...) if "time" in matrix.dims else matrix
+        matrix = da.values
+    C = _v.vectors(matrix, "matrix", width=None, ndim=None, allow_nan=True)
+    if C.ndim < 2 or C.shape[-2:] != (3, 3):
+        raise ValueError(f"matrix must have shape (..., 3, 3), got {C.shape}")
     _quat.check_rotation(C, "matrix")
-    h = np.hypot(C[..., 0, 0], C[..., 1, 0])
-    el = np.arctan2(C[..., 2, 0], h)
-    az = np.arctan2(C[..., 1, 0], C[..., 0, 0])
-    bk = np.arctan2(C[..., 2, 1], C[..., 2, 2])
-    sing = h < singular_tol
-    az = np.where(
-        sing, wrap_angle(np.arctan2(C[..., 1, 1], C[..., 0, 1]) - np.pi / 2), az
+    return _labelled_orientation(
+        _orientation(C, singular_tol), da, () if da is None else da.dims[-2:]
     )
-    bk = np.where(sing, 0.0, bk)
-    return Orientation(az, el, bk)
 
 
 def angles_to_quaternion(azimuth, elevation, bank) -> np.ndarray:
@@ -387,17 +467,23 @@ def angles_to_quaternion(azimuth, elevation, bank) -> np.ndarray:
 
     Parameters
     ----------
-    azimuth : array_like
-        Azimuth θ in rad (heading of the surge axis, counter-clockwise from East).
-    elevation : array_like
-        Elevation φ in rad (positive nose up).
-    bank : array_like
-        Bank λ in rad (roll about the surge axis). The three angles broadcast.
+    azimuth, elevation, bank : array_like
+        Azimuth θ, elevation φ and bank λ in rad, as for :func:`angles_to_matrix`;
+        they broadcast.
 
     Returns
     -------
     numpy.ndarray, shape (..., 4)
         Unit quaternions (w, x, y, z), w ≥ 0, rotating body (sensor) to world.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from tiltlab import trig
+    >>> np.round(trig.angles_to_quaternion(np.pi / 2, 0.0, 0.0), 3)  # facing North
+    array([0.707, 0.   , 0.   , 0.707])
+    >>> np.round(trig.angles_to_quaternion(0.0, np.radians(30), 0.0), 3)  # nose up
+    array([ 0.966,  0.   , -0.259,  0.   ])
     """
     t, p, lam = np.broadcast_arrays(
         *(
@@ -417,12 +503,20 @@ def angles_to_quaternion(azimuth, elevation, bank) -> np.ndarray:
 
 
 def angles_from_quaternion(q, singular_tol: float = 1e-9) -> Orientation:
-    """Azimuth, elevation, bank of sensor(body)→world quaternions (see :func:`angles_from_matrix`).
+    """Compute azimuth, elevation and bank (rad) of sensor(body)→world quaternions.
+
+    See :func:`angles_from_matrix` for the formulas and the singular (surge vertical)
+    fallback. A DataArray with a ``quat`` dimension (e.g. the output of
+    :func:`tiltlab.filters.estimate`) gives DataArrays with its ``time`` coordinate and
+    ``fs``. Non-unit quaternions are refused (normalise them first with
+    :func:`tiltlab.quaternion.normalize`); NaN rows (missing samples) give NaN angles.
 
     Parameters
     ----------
-    q : array_like, shape (..., 4)
-        Unit body (sensor) → world quaternions (w, x, y, z), norm 1 within 1e-6.
+    q : array_like, shape (..., 4), or xarray.DataArray
+        Unit body (sensor) → world quaternions (w, x, y, z), norm 1 within 1e-6; a
+        DataArray has a ``quat`` dimension (else its last dimension holds the
+        components).
     singular_tol : float, optional
         Threshold (≥ 0) on cos φ below which the configuration is treated as singular
         (default 1e-9); see :func:`angles_from_matrix`.
@@ -430,20 +524,33 @@ def angles_from_quaternion(q, singular_tol: float = 1e-9) -> Orientation:
     Returns
     -------
     Orientation
-        Named tuple ``(azimuth, elevation, bank)`` of arrays of shape (...), in rad:
-        azimuth θ and bank λ in (−π, π], elevation φ in [−π/2, π/2].
+        The angles of each quaternion, as :func:`angles_from_matrix` returns them.
+
+    Raises
+    ------
+    ValueError
+        If ``q`` has a wrong shape, holds ±inf or quaternions whose norm is not 1
+        (zero ones included), or ``singular_tol`` is negative or NaN.
     """
-    q = np.asarray(q, dtype=float)
-    if q.ndim == 0 or q.shape[-1] != 4:
-        raise ValueError(f"q must have a last dimension of size 4, got {q.shape}")
-    _quat.check_unit(q, "q")
-    return angles_from_matrix(_quat.to_matrix(q), singular_tol=singular_tol)
+    singular_tol = _v.nonnegative(singular_tol, "singular_tol")
+    da, qd = None, ()
+    if isinstance(q, xr.DataArray):
+        qd = ("quat" if "quat" in q.dims else q.dims[-1],)
+        da = q.transpose(..., *qd)
+        da = da.transpose("time", ...) if "time" in da.dims else da
+        q = da.values
+    qv = _v.vectors(q, "q", width=4, ndim=None, allow_nan=True)
+    _quat.check_unit(qv, "q")
+    qv = qv / np.linalg.norm(qv, axis=-1, keepdims=True)  # exact within the tolerance
+    return _labelled_orientation(
+        _orientation(_quat.to_matrix(qv), singular_tol), da, qd
+    )
 
 
 def acc_from_angles(
     elevation, bank, g: float = 1.0, convention: Convention = "tiltlab"
 ) -> np.ndarray:
-    r"""Static accelerometer reading of a body at rest with elevation φ and bank λ, shape (..., 3).
+    r"""Compute the static accelerometer reading of a body at rest with elevation φ and bank λ.
 
     Specific force (``"tiltlab"``): :math:`g\,C^\top e_z = g(\sin\phi, \cos\phi\sin\lambda, \cos\phi\cos\lambda)`;
     ``"benhamou"`` returns its negative.
@@ -465,6 +572,15 @@ def acc_from_angles(
     -------
     numpy.ndarray, shape (..., 3)
         Accelerometer readings in body axes, in the unit of ``g``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from tiltlab import trig
+    >>> np.round(trig.acc_from_angles(np.radians(30), 0.0), 3)  # nose 30° up
+    array([0.5  , 0.   , 0.866])
+    >>> np.round(trig.acc_from_angles(0.0, np.radians(90), g=9.81), 3)  # on its side
+    array([0.  , 9.81, 0.  ])
     """
     g = _v.positive(g, "g")
     convention = _convention(convention)
@@ -475,55 +591,14 @@ def acc_from_angles(
     return f if convention == "tiltlab" else _as_benhamou(f, "tiltlab")
 
 
-def geomagnetic_field(
-    intensity: float = 48.0,
-    inclination: float = np.radians(64.0),
-    declination: float = 0.0,
-) -> np.ndarray:
-    r"""Geomagnetic field in ENU coordinates.
-
-    ``inclination`` is the dip angle, positive *downwards* (northern hemisphere),
-    ``declination`` is positive East of true North:
-    :math:`B(\cos I\sin D, \cos I\cos D, -\sin I)`.
-
-    Parameters
-    ----------
-    intensity : float, optional
-        Total field intensity (> 0), in the unit wanted for the output; default 48.0
-        (µT).
-    inclination : float, optional
-        Dip angle I in rad, positive downwards; default 64° (in rad).
-    declination : float, optional
-        Declination D in rad, positive East of true North; default 0.
-
-    Returns
-    -------
-    numpy.ndarray, shape (3,)
-        Field (East, North, Up) in the unit of ``intensity``.
-    """
-    intensity = _v.positive(intensity, "intensity")
-    inclination = _v.finite(inclination, "inclination")
-    declination = _v.finite(declination, "declination")
-    return intensity * np.array(
-        [
-            np.cos(inclination) * np.sin(declination),
-            np.cos(inclination) * np.cos(declination),
-            -np.sin(inclination),
-        ]
-    )
-
-
 def mag_from_angles(azimuth, elevation, bank, field=None) -> np.ndarray:
     """Magnetometer reading (field in body axes, :math:`C^T m_{ENU}`) for orientations θ, φ, λ, shape (..., 3).
 
     Parameters
     ----------
-    azimuth : array_like
-        Azimuth θ in rad (heading of the surge axis, counter-clockwise from East).
-    elevation : array_like
-        Elevation φ in rad (positive nose up).
-    bank : array_like
-        Bank λ in rad (roll about the surge axis). The three angles broadcast.
+    azimuth, elevation, bank : array_like
+        Azimuth θ, elevation φ and bank λ in rad, as for :func:`angles_to_matrix`;
+        they broadcast.
     field : array_like, shape (3,), optional
         Earth magnetic field in ENU world coordinates, any unit (kept); the default,
         ``None``, is ``geomagnetic_field()`` (48 µT, dip 64°).

@@ -1,19 +1,20 @@
-"""Quaternion algebra: identity, product, conjugate, inverse, norm, rotation of
-vectors, and conversions to and from matrices, rotation vectors, exp and log.
+"""Quaternion algebra: identity, product, conjugate, inverse, norm and rotation.
+
+Also the conversions to and from matrices, rotation vectors, exp and log.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from .. import _validate as _v
+import tiltlab._validate as _v
 from ._checks import (
     _as2d,
     _broadcast,
     _check_last,
-    _no_inf,
-    _no_zero,
+    _finite,
     _real,
+    _rotations,
     check_rotation,
     check_unit,
 )
@@ -28,7 +29,7 @@ from ._kernels import (
 
 
 def identity(n: int | None = None) -> np.ndarray:
-    """The identity quaternion (1, 0, 0, 0), or ``n`` of them.
+    """Return the identity quaternion (1, 0, 0, 0), or ``n`` of them.
 
     Parameters
     ----------
@@ -67,10 +68,7 @@ def mul(p, q) -> np.ndarray:
     numpy.ndarray, shape (..., 4)
         The Hamilton products ``p ⊗ q`` (w, x, y, z), with the broadcast shape.
     """
-    p, q = _real(p, "p"), _real(q, "q")
-    _check_last(p, 4, "p")
-    _check_last(q, 4, "q")
-    p, q = _broadcast(("p", _no_inf(p, "p")), ("q", _no_inf(q, "q")))
+    p, q = _broadcast(("p", _finite(p, 4, "p")), ("q", _finite(q, 4, "q")))
     shape = p.shape
     out = np.empty((int(np.prod(shape[:-1], dtype=np.int64)), 4))
     _mul_kernel(_as2d(p, 4), _as2d(q, 4), out)
@@ -97,7 +95,7 @@ def conj(q) -> np.ndarray:
 
 
 def inv(q) -> np.ndarray:
-    """Inverse :math:`q^* / \\|q\\|^2` (equals :func:`conj` for unit quaternions).
+    r"""Invert quaternions: :math:`q^* / \|q\|^2` (equals :func:`conj` for unit quaternions).
 
     Parameters
     ----------
@@ -109,9 +107,7 @@ def inv(q) -> np.ndarray:
     numpy.ndarray, shape (..., 4)
         The inverses (w, x, y, z), such that ``mul(q, inv(q))`` is the identity.
     """
-    q = _real(q, "q")
-    _check_last(q, 4, "q")
-    _no_zero(_no_inf(q, "q"), "q")
+    q = _rotations(q, "q")
     return conj(q) / np.sum(q * q, axis=-1, keepdims=True)
 
 
@@ -132,7 +128,7 @@ def norm(q) -> np.ndarray:
 
 
 def normalize(q) -> np.ndarray:
-    """Unit quaternions; a zero quaternion is an error.
+    """Normalise quaternions to unit norm; a zero quaternion is an error.
 
     Parameters
     ----------
@@ -144,8 +140,7 @@ def normalize(q) -> np.ndarray:
     numpy.ndarray, shape (..., 4)
         ``q`` divided by its norm: unit quaternions of the same rotations.
     """
-    q = _no_inf(_real(q, "q"), "q")
-    _check_last(q, 4, "q")
+    q = _finite(q, 4, "q")
     n = np.linalg.norm(q, axis=-1, keepdims=True)
     if np.any(n == 0):
         raise ValueError(
@@ -155,7 +150,7 @@ def normalize(q) -> np.ndarray:
 
 
 def canonical(q) -> np.ndarray:
-    """The representative with w ≥ 0 (q and −q are the same rotation).
+    """Return the representative with w ≥ 0 (q and −q are the same rotation).
 
     Parameters
     ----------
@@ -198,26 +193,20 @@ def rotate_inverse(q, v) -> np.ndarray:
     Parameters
     ----------
     q : array_like, shape (..., 4)
-        Unit sensor → world quaternions (w, x, y, z); not renormalised.
+        Unit sensor → world quaternions, as for :func:`rotate`.
     v : array_like, shape (..., 3)
-        Vectors in world coordinates, in any unit (kept). The leading dimensions of
-        ``q`` and ``v`` broadcast.
+        Vectors in world coordinates (any unit, kept; broadcast with ``q``).
 
     Returns
     -------
     numpy.ndarray, shape (..., 3)
-        The same vectors in sensor coordinates, in the unit of ``v``, with the broadcast
-        leading shape.
+        ``v`` in sensor coordinates: the inverse rotation of :func:`rotate`.
     """
     return _rotate(q, v, True)
 
 
 def _rotate(q, v, inverse: bool) -> np.ndarray:
-    q, v = _real(q, "q"), _real(v, "v")
-    _check_last(q, 4, "q")
-    _check_last(v, 3, "v")
-    _no_zero(_no_inf(q, "q"), "q")
-    _no_inf(v, "v")
+    q, v = _rotations(q, "q"), _finite(v, 3, "v")
     lead = _broadcast(("q", q[..., 0]), ("v", v[..., 0]))[0].shape
     qb = np.broadcast_to(q, lead + (4,))
     vb = np.broadcast_to(v, lead + (3,))
@@ -248,7 +237,7 @@ def to_matrix(q) -> np.ndarray:
 
 
 def from_matrix(m) -> np.ndarray:
-    """Unit quaternions (w ≥ 0) from rotation matrices (Shepperd's method [2]_).
+    """Convert rotation matrices to unit quaternions (w ≥ 0) by Shepperd's method [2]_.
 
     Parameters
     ----------
@@ -292,7 +281,7 @@ def to_rotvec(q) -> np.ndarray:
 
 
 def from_rotvec(r) -> np.ndarray:
-    r"""Unit quaternions :math:`(\cos\tfrac{\theta}{2}, \sin\tfrac{\theta}{2}\,\hat r)` from rotation vectors.
+    r"""Convert rotation vectors to unit quaternions :math:`(\cos\tfrac{\theta}{2}, \sin\tfrac{\theta}{2}\,\hat r)`.
 
     Parameters
     ----------
@@ -304,8 +293,7 @@ def from_rotvec(r) -> np.ndarray:
     numpy.ndarray, shape (..., 4)
         Unit quaternions (w, x, y, z) of the same rotations.
     """
-    r = _no_inf(_real(r, "r"), "r")
-    _check_last(r, 3, "r")
+    r = _finite(r, 3, "r")
     with np.errstate(over="ignore"):
         big = np.isinf(np.linalg.norm(r, axis=-1))
     if np.any(big):
@@ -341,7 +329,7 @@ def log(q) -> np.ndarray:
     Parameters
     ----------
     q : array_like, shape (..., 4)
-        Unit quaternions (w, x, y, z), norm 1 within 1e-6.
+        Unit quaternions, as for :func:`to_rotvec`.
 
     Returns
     -------

@@ -8,9 +8,7 @@ import numpy as np
 
 
 def _real(a, name: str) -> np.ndarray:
-    """``a`` as a float array; complex input is refused by name (never cut to its
-    real part).
-    """
+    """Return ``a`` as a float array; refuse complex input by name (never cut to real)."""
     raw = np.asarray(a)
     if raw.dtype.kind == "c":
         raise ValueError(
@@ -43,7 +41,7 @@ def _broadcast(*named) -> list[np.ndarray]:
 
 
 def _no_inf(a: np.ndarray, name: str) -> np.ndarray:
-    """``a`` unchanged; infinite values raise (NaN, a missing sample, passes)."""
+    """Return ``a`` unchanged; raise on infinite values (NaN, a missing sample, passes)."""
     if np.any(np.isinf(a)):
         raise ValueError(f"{name} has {int(np.sum(np.isinf(a)))} infinite values")
     return a
@@ -56,10 +54,36 @@ def _no_zero(q: np.ndarray, name: str) -> np.ndarray:
     return q
 
 
+def _finite(a, width: int, name: str) -> np.ndarray:
+    """Return ``a`` as a real float array (..., ``width``) without ±inf; else raise naming it."""
+    a = _real(a, name)
+    _check_last(a, width, name)
+    return _no_inf(a, name)
+
+
+def _rotations(q, name: str) -> np.ndarray:
+    """Return ``q`` as real quaternions (..., 4) that can be rotations: no ±inf, no zero."""
+    return _no_zero(_finite(q, 4, name), name)
+
+
 def check_unit(q: np.ndarray, name: str = "q", atol: float = 1e-6) -> None:
     """Raise unless every finite quaternion of ``q`` (…, 4) has norm 1 within ``atol``.
 
     NaN quaternions (missing samples) pass; infinities do not.
+
+    Parameters
+    ----------
+    q : numpy.ndarray, shape (..., 4)
+        The quaternions.
+    name : str, optional
+        Argument name used in the error message (default ``"q"``).
+    atol : float, optional
+        Tolerance on the norm (default 1e-6).
+
+    Raises
+    ------
+    ValueError
+        If a quaternion holds ±inf or has a norm other than 1 (zero included).
     """
     if np.any(np.isinf(q)):
         raise ValueError(f"{name} has infinite values")
@@ -75,8 +99,24 @@ def check_unit(q: np.ndarray, name: str = "q", atol: float = 1e-6) -> None:
 
 
 def check_rotation(m: np.ndarray, name: str = "m", atol: float = 1e-6) -> None:
-    """Raise unless every finite (3, 3) matrix of ``m`` is a proper rotation
-    (orthonormal within ``atol``, determinant +1). NaN matrices pass; infinities do not.
+    r"""Raise unless every finite (3, 3) matrix of ``m`` is a proper rotation.
+
+    Proper: orthonormal within ``atol``, determinant +1. NaN matrices (missing samples)
+    pass; infinities do not.
+
+    Parameters
+    ----------
+    m : numpy.ndarray, shape (..., 3, 3)
+        The matrices.
+    name : str, optional
+        Argument name used in the error message (default ``"m"``).
+    atol : float, optional
+        Tolerance on :math:`\max|M^\top M - I|` (default 1e-6).
+
+    Raises
+    ------
+    ValueError
+        If a matrix holds ±inf, is not orthonormal or is a reflection (det −1).
     """
     if np.any(np.isinf(m)):
         raise ValueError(f"{name} has infinite values")

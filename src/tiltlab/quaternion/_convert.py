@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .. import _validate as _v
+import tiltlab._validate as _v
 from ._algebra import canonical, identity
 from ._checks import (
     _broadcast,
@@ -149,7 +149,7 @@ def from_scipy(rot) -> np.ndarray:
 
 
 def to_scipy(q):
-    """A :class:`scipy.spatial.transform.Rotation` from scalar-first quaternions.
+    """Build a :class:`scipy.spatial.transform.Rotation` from scalar-first quaternions.
 
     Parameters
     ----------

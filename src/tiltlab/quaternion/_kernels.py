@@ -1,5 +1,7 @@
-"""Numba kernels of :mod:`tiltlab.quaternion`: the inlined scalar helpers (also used by
-tiltlab.filters and tiltlab.simulate) and the array loops behind the public wrappers.
+"""Numba kernels of :mod:`tiltlab.quaternion`: inlined scalar helpers and array loops.
+
+The scalar helpers are also used by tiltlab.filters and tiltlab.simulate; the array
+loops run behind the public wrappers.
 """
 
 from __future__ import annotations
@@ -14,7 +16,20 @@ from numba import njit
 
 @njit(cache=True, inline="always")
 def qmul_scalar(aw, ax, ay, az, bw, bx, by, bz):
-    """Hamilton product of two quaternions given by components; returns (w, x, y, z)."""
+    """Compute the Hamilton product of two quaternions given by components.
+
+    Parameters
+    ----------
+    aw, ax, ay, az : float
+        Components of the left factor (w, x, y, z).
+    bw, bx, by, bz : float
+        Components of the right factor (w, x, y, z).
+
+    Returns
+    -------
+    tuple of float
+        The product (w, x, y, z).
+    """
     return (
         aw * bw - ax * bx - ay * by - az * bz,
         aw * bx + ax * bw + ay * bz - az * by,
@@ -25,7 +40,18 @@ def qmul_scalar(aw, ax, ay, az, bw, bx, by, bz):
 
 @njit(cache=True, inline="always")
 def rotvec_to_quat_scalar(rx, ry, rz):
-    """Unit quaternion of the rotation vector (rx, ry, rz), with series below 1e-4 rad."""
+    """Convert the rotation vector (rx, ry, rz) to a unit quaternion (series below 1e-4 rad).
+
+    Parameters
+    ----------
+    rx, ry, rz : float
+        Rotation vector components (rad).
+
+    Returns
+    -------
+    tuple of float
+        The unit quaternion (w, x, y, z).
+    """
     th2 = rx * rx + ry * ry + rz * rz
     th = np.sqrt(th2)
     if th < 1e-4:
@@ -40,14 +66,35 @@ def rotvec_to_quat_scalar(rx, ry, rz):
 
 @njit(cache=True, inline="always")
 def zoh_step_scalar(w, x, y, z, rx, ry, rz):
-    """Q ⊗ exp(r / 2) for the rotation vector r = ω Δt (not renormalised)."""
+    """Step a quaternion by a rotation vector: q ⊗ exp(r / 2), r = ω Δt (not renormalised).
+
+    Parameters
+    ----------
+    w, x, y, z : float
+        The quaternion components.
+    rx, ry, rz : float
+        The rotation vector (rad), in the frame of ``q``'s sensor.
+
+    Returns
+    -------
+    tuple of float
+        The stepped quaternion (w, x, y, z).
+    """
     dw, dx, dy, dz = rotvec_to_quat_scalar(rx, ry, rz)
     return qmul_scalar(w, x, y, z, dw, dx, dy, dz)
 
 
 @njit(cache=True, inline="always")
 def rotmat_scalar(w, x, y, z, R):
-    """Write the rotation matrix R(q) of a unit quaternion into the (3, 3) array ``R``."""
+    """Write the rotation matrix R(q) of a unit quaternion into the (3, 3) array ``R``.
+
+    Parameters
+    ----------
+    w, x, y, z : float
+        The unit quaternion components.
+    R : numpy.ndarray, shape (3, 3)
+        Output array, overwritten.
+    """
     R[0, 0] = 1.0 - 2.0 * (y * y + z * z)
     R[0, 1] = 2.0 * (x * y - w * z)
     R[0, 2] = 2.0 * (x * z + w * y)
@@ -61,7 +108,20 @@ def rotmat_scalar(w, x, y, z, R):
 
 @njit(cache=True, inline="always")
 def rotate_scalar(w, x, y, z, vx, vy, vz):
-    """R(q) v for one quaternion and one vector, via v + 2w(u×v) + 2u×(u×v)."""
+    """Rotate one vector by one quaternion: R(q) v = v + 2w(u×v) + 2u×(u×v).
+
+    Parameters
+    ----------
+    w, x, y, z : float
+        The unit quaternion components (u = (x, y, z)).
+    vx, vy, vz : float
+        The vector components.
+
+    Returns
+    -------
+    tuple of float
+        The rotated vector (x, y, z).
+    """
     tx = 2.0 * (y * vz - z * vy)
     ty = 2.0 * (z * vx - x * vz)
     tz = 2.0 * (x * vy - y * vx)

@@ -1,5 +1,6 @@
-r"""Body-rotation trigonometry for bio-logging (Benhamou 2023): posture, heading, arcs,
-rotations, dead reckoning, oscillations.
+r"""Body-rotation trigonometry for bio-logging (Benhamou 2023).
+
+Posture, heading, arcs, rotations, dead reckoning and oscillations.
 
 This package implements, as vectorised numpy functions, the classical-trigonometry
 formulas of Benhamou (2023) [1]_ (§1–§9 and Appendices A–C) for tri-axial
@@ -50,11 +51,11 @@ Modules
   on a known track (§8);
 * :mod:`~tiltlab.trig.oscillations` — crossing times and oscillation statistics (§9).
 
-Benhamou's frames, rotation matrices and sign conventions live in
-:mod:`tiltlab.frames` and are re-exported here; :func:`wrap_angle`,
-:func:`angles_from_quaternion` and :func:`angles_from_matrix` are the labelled,
-checked versions of :mod:`~tiltlab.trig.angles` (DataArrays in, DataArrays out;
-non-unit quaternions normalised with a warning; reflections refused). Static acceleration and DBA (§2, §9)
+Benhamou's frames, rotation matrices, sign conventions and angle conversions live in
+:mod:`tiltlab.frames` and are re-exported here (the same objects): :func:`wrap_angle`,
+:func:`angles_from_quaternion` and :func:`angles_from_matrix` accept labelled input
+(DataArrays in, DataArrays out) and refuse non-unit quaternions and matrices that are
+not rotations (reflections included). Static acceleration and DBA (§2, §9)
 are in :mod:`tiltlab.behavior`; the four-point magnetometer calibration (Eq. 4) in
 :mod:`tiltlab.calibration`.
 
@@ -112,6 +113,8 @@ from ..frames import (
     Convention,
     Orientation,
     acc_from_angles,
+    angles_from_matrix,
+    angles_from_quaternion,
     angles_to_matrix,
     angles_to_quaternion,
     body_rates_to_gyro,
@@ -126,10 +129,11 @@ from ..frames import (
     spherical_coords,
     to_benhamou_acc,
     unit_vector,
+    wrap_angle,
 )
+from ..frames import __all__ as _frames_all
 from ._types import Arc, OscillationStats, Posture, Rotations
 from .anchors import anchor_steps, dead_reckon_every
-from .angles import angles_from_matrix, angles_from_quaternion, wrap_angle
 from .arcs import *  # noqa: F401,F403
 from .arcs import __all__ as _arcs
 from .deadreckoning import *  # noqa: F401,F403
@@ -143,30 +147,15 @@ from .posture import __all__ as _posture
 from .rotations import *  # noqa: F401,F403
 from .rotations import __all__ as _rot
 
-_FRAMES = [
-    "R1",
-    "R2",
-    "R3",
-    "Convention",
-    "unit_vector",
-    "spherical_coords",
-    "wrap_angle",
-    "to_benhamou_acc",
-    "from_benhamou_acc",
-    "gyro_to_body_rates",
-    "body_rates_to_gyro",
-    "angles_to_matrix",
-    "angles_from_matrix",
-    "angles_to_quaternion",
-    "angles_from_quaternion",
-    "acc_from_angles",
-    "geomagnetic_field",
-    "mag_from_angles",
-    "mounting_angles",
-    "mounting_matrix",
-    "device_to_body",
-    "device_to_body_eq1",
-]
+# Benhamou's frames and conventions, re-exported (the same objects as in tiltlab.frames);
+# Fayat's tumble stage and marker frame stay there, Orientation is listed below.
+_FAYAT = (
+    "fibonacci_lattice",
+    "stage_angles",
+    "stage_quaternion",
+    "head_frame_from_markers",
+)
+_FRAMES = [n for n in _frames_all if n not in (*_FAYAT, "Orientation")]
 
 __all__ = [
     *_FRAMES,

@@ -22,12 +22,13 @@ import inspect
 import numpy as np
 import xarray as xr
 
-from .. import _validate as _v
+import tiltlab._validate as _v
 from .._validate import output as label
+from .._frames_lab import _angle_units, _label_as, _label_attrs
 from .._validate import start_time, windowed
 
 __all__ = [
-    "read",
+    "read_input",
     "label",
     "start_time",
     "windowed",
@@ -38,11 +39,44 @@ __all__ = [
     "label_like",
 ]
 
-read = functools.partial(_v.signal, need_fs=False, ndim=None, allow_nan=True)
+
+def read_input(data, name: str, **options) -> _v.Signal:
+    """Read one per-sample input with trig's defaults (:func:`tiltlab._validate.signal`).
+
+    Parameters
+    ----------
+    data : xarray.Dataset, xarray.DataArray or array_like
+        A Recording, a labelled DataArray or a plain array.
+    name : str
+        The argument name (used in messages, and the Recording variable read).
+    **options
+        Keyword options of :func:`tiltlab._validate.signal`; trig's defaults are
+        ``need_fs=False``, ``ndim=None`` and ``allow_nan=True``.
+
+    Returns
+    -------
+    tiltlab._validate.Signal
+        The checked values with their ``fs``, units, time and labelling.
+    """
+    kw = {"need_fs": False, "ndim": None, "allow_nan": True, **options}
+    return _v.signal(data, name, **kw)
 
 
 def pair(acc, mag):
-    """The magnetometer input: ``mag``, or the Recording ``acc`` when ``mag`` is None."""
+    """Return the magnetometer input: ``mag``, or the Recording ``acc`` when ``mag`` is None.
+
+    Parameters
+    ----------
+    acc : xarray.Dataset, xarray.DataArray or array_like
+        The acceleration argument (a Recording holding ``mag`` too, or not).
+    mag : xarray.DataArray, array_like or None
+        The magnetometer argument.
+
+    Returns
+    -------
+    xarray.Dataset, xarray.DataArray or array_like
+        What to read the magnetic field from.
+    """
     if mag is not None:
         return mag
     if isinstance(acc, xr.Dataset):
@@ -51,22 +85,45 @@ def pair(acc, mag):
 
 
 def first_labelled(*signals: _v.Signal) -> _v.Signal:
-    """The first labelled signal (to label an output), else the first one."""
+    """Return the first labelled signal (to label an output), else the first one.
+
+    Parameters
+    ----------
+    *signals : tiltlab._validate.Signal
+        Inputs read by :func:`read_input`.
+
+    Returns
+    -------
+    tiltlab._validate.Signal
+        The first one that is labelled, else ``signals[0]``.
+    """
     for s in signals:
         if s.labelled:
             return s
     return signals[0]
 
 
-_RAD = ("rad", "radian", "radians", "1", "")  # SI: rad = 1
-_DEG = ("deg", "degree", "degrees", "°")
-
-
 def read_angles(a: xr.DataArray, name: str, *, angle: bool = True):
-    """Values (float array, ``time`` first) and the (transposed) DataArray of a labelled angle.
+    """Return the values (float array, ``time`` first) and the DataArray of a labelled angle.
 
     With ``angle``, ``attrs["units"]`` must be radians or degrees (converted to radians);
     no units means radians. An ``fs`` attribute must be a valid sampling rate.
+
+    Parameters
+    ----------
+    a : xarray.DataArray
+        The labelled argument.
+    name : str
+        Its name, used in messages.
+    angle : bool, optional
+        Whether it is an angle (its units are then checked; default True).
+
+    Returns
+    -------
+    values : numpy.ndarray
+        The values in rad (or as given when ``angle`` is False), ``time`` first.
+    da : xarray.DataArray
+        ``a`` with ``time`` moved first.
     """
     da = a.transpose("time", ...) if "time" in a.dims else a
     try:
@@ -75,33 +132,39 @@ def read_angles(a: xr.DataArray, name: str, *, angle: bool = True):
         raise ValueError(f"{name} must be numeric, got dtype {da.dtype}") from None
     if "fs" in da.attrs:
         _v.check_fs(da.attrs["fs"], name=f"{name} attribute fs")
-    units = da.attrs.get("units")
-    if angle and units is not None:
-        key = str(units).strip().lower()
-        if key in _DEG:
-            values = np.radians(values)
-        elif key not in _RAD:
-            raise ValueError(
-                f"{name} must be an angle in rad (or deg), got units {units!r}"
-            )
+    if angle and _angle_units(da, name) == "deg":
+        values = np.radians(values)
     return values, da
 
 
 def label_like(values, da: xr.DataArray, name: str, units: str | None, attrs=None):
-    """``values`` as a DataArray labelled like ``da`` (its dims and coordinates when the
-    shapes agree, else its ``time`` coordinate), with ``fs`` (and ``method``) kept.
+    """Label ``values`` like ``da``, keeping its ``fs`` (and ``method``).
+
+    The output has ``da``'s dims and coordinates when the shapes agree, else its
+    ``time`` coordinate.
+
+    Parameters
+    ----------
+    values : array_like
+        The output values.
+    da : xarray.DataArray
+        The labelled input to copy labels from.
+    name : str
+        The output's name.
+    units : str or None
+        The output's units.
+    attrs : dict, optional
+        Further attributes.
+
+    Returns
+    -------
+    xarray.DataArray
+        ``values`` labelled like ``da``.
     """
     values = np.asarray(values)
-    a: dict = {}
-    for key in ("fs", "method"):
-        if key in da.attrs:
-            a[key] = da.attrs[key]
-    if units is not None:
-        a["units"] = units
-    if attrs:
-        a.update(attrs)
     if values.shape == da.shape:
-        return xr.DataArray(values, dims=da.dims, coords=da.coords, name=name, attrs=a)
+        return _label_as(values, da, name, units, attrs)
+    a = _label_attrs(da, units, attrs)
     if values.ndim == 0:
         return xr.DataArray(values, name=name, attrs=a)
     time = None
@@ -114,7 +177,7 @@ def label_like(values, da: xr.DataArray, name: str, units: str | None, attrs=Non
 
 
 def angle_function(names, *, units="rad", angles=None):
-    """Decorator for per-sample functions of angles: labelled in, labelled out.
+    """Wrap a per-sample function of angles: labelled in, labelled out.
 
     ``names``: the output's name (a string) or names (one per element of a tuple
     result; a NamedTuple's own field names win). ``units``: the output units (one
@@ -124,6 +187,20 @@ def angle_function(names, *, units="rad", angles=None):
     Labelled arguments need not share a time axis (``azimuth_change`` takes two
     orientations at consecutive times); they must have matching lengths, and the output
     carries the first labelled argument's ``time``.
+
+    Parameters
+    ----------
+    names : str or tuple of str
+        The output's name(s).
+    units : str or sequence of str, optional
+        The output's units (default ``"rad"``).
+    angles : sequence of str, optional
+        The parameters that are angles (default all).
+
+    Returns
+    -------
+    callable
+        The decorator.
     """
 
     def deco(f):

@@ -16,9 +16,7 @@ __all__ = ["Orientation", "Posture", "Arc", "Rotations", "OscillationStats"]
 
 
 class Posture(NamedTuple):
-    """Elevation φ, bank λ (Eq. 3), overall inclination ζ and postural orientation χ
-    (Eq. 2), rad.
-    """
+    """Elevation φ, bank λ (Eq. 3), inclination ζ and postural orientation χ (Eq. 2), rad."""
 
     elevation: np.ndarray
     bank: np.ndarray
@@ -27,9 +25,7 @@ class Posture(NamedTuple):
 
 
 class Arc(NamedTuple):
-    """Orthodromic arc: size ω ∈ [0, π], initial and final inclinations δ^i, δ^f
-    (rad).
-    """
+    """Orthodromic arc: size ω ∈ [0, π], initial and final inclinations δ^i, δ^f (rad)."""
 
     size: np.ndarray
     initial: np.ndarray
@@ -37,8 +33,9 @@ class Arc(NamedTuple):
 
 
 class Rotations(NamedTuple):
-    """Body rotations over a step: yaw α (heave axis), pitch β (sway axis, + nose up),
-    roll ρ (surge axis), rad.
+    """Body rotations over a step: yaw α, pitch β (+ nose up), roll ρ (rad).
+
+    Yaw is about the heave axis, pitch about the sway axis, roll about the surge axis.
     """
 
     yaw: np.ndarray
@@ -47,8 +44,9 @@ class Rotations(NamedTuple):
 
 
 class OscillationStats(NamedTuple):
-    """Per-window crossing statistics: window centre time (s), mean delay d̄ (s), CV,
-    period 2d̄ (s), number of intervals.
+    """Per-window crossing statistics.
+
+    Window centre time (s), mean delay d̄ (s), CV, period 2d̄ (s), number of intervals.
     """
 
     time: np.ndarray

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .. import _validate as _v
+import tiltlab._validate as _v
 from ..frames import _vec3
 from .deadreckoning import dead_reckon
 

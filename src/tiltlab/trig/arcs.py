@@ -39,10 +39,9 @@ def arc(az0, el0, az1, el1) -> Arc:
 
     Parameters
     ----------
-    az0, el0 : float or array_like
-        Azimuth θ0 and elevation φ0 (rad) of the initial heading.
-    az1, el1 : float or array_like
-        Azimuth θ1 and elevation φ1 (rad) of the final heading.
+    az0, el0, az1, el1 : float or array_like
+        Azimuth θ0 and elevation φ0 of the initial heading, θ1 and φ1 of the final one
+        (rad); they broadcast.
 
     Returns
     -------
@@ -68,10 +67,8 @@ def arc_inclination(az0, el0, az1, el1, q) -> np.ndarray:
 
     Parameters
     ----------
-    az0, el0 : float or array_like
-        Azimuth θ0 and elevation φ0 (rad) of the initial heading.
-    az1, el1 : float or array_like
-        Azimuth θ1 and elevation φ1 (rad) of the final heading.
+    az0, el0, az1, el1 : float or array_like
+        The initial and final headings (rad), as for :func:`arc`.
     q : float or array_like
         Fraction of the arc, in [0, 1] (0: start, 1: end).
 
@@ -201,10 +198,9 @@ def posture_change(el0, bank0, el1, bank1) -> np.ndarray:
 
     Parameters
     ----------
-    el0, bank0 : float or array_like
-        Elevation φ0 and bank λ0 (rad) of the initial posture.
-    el1, bank1 : float or array_like
-        Elevation φ1 and bank λ1 (rad) of the final posture.
+    el0, bank0, el1, bank1 : float or array_like
+        Elevation φ and bank λ (rad) of the initial (0) and final (1) postures; all
+        four broadcast.
 
     Returns
     -------

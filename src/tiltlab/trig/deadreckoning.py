@@ -11,7 +11,7 @@ import warnings
 
 import numpy as np
 
-from .. import _validate as _v
+import tiltlab._validate as _v
 from ..frames import _vec3, unit_vector, wrap_angle
 
 __all__ = [
@@ -122,8 +122,10 @@ def velocity_components(speed, az, el=None) -> np.ndarray:
 
 
 def _steps(**named) -> list[np.ndarray]:
-    """Per-step inputs as finite 1-D arrays of one length; NaN/inf or a mismatch is an
-    error naming the argument (a NaN step would corrupt its whole anchor interval).
+    """Check per-step inputs: finite 1-D arrays of one length.
+
+    NaN/inf or a mismatch is an error naming the argument (a NaN step would corrupt its
+    whole anchor interval).
     """
     out = [_v.vectors(a, k, width=None, ndim=1) for k, a in named.items()]
     n = out[0].shape[0]

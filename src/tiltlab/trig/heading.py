@@ -1,5 +1,6 @@
-r"""Heading: azimuth from acceleration and magnetic field (Benhamou 2023 §3, Eqs. 5, 18,
-App. A).
+r"""Heading: azimuth from acceleration and magnetic field.
+
+Benhamou 2023 §3, Eqs. 5, 18 and App. A.
 
 :func:`azimuth`, :func:`collar_azimuth` and :func:`heading` take ``acc`` and ``mag`` as
 Recordings, labelled DataArrays or plain arrays (..., 3); pass a Recording alone
@@ -15,7 +16,7 @@ import warnings
 
 import numpy as np
 
-from .. import _validate as _v
+import tiltlab._validate as _v
 from ..frames import (
     R1,
     R2,
@@ -26,7 +27,7 @@ from ..frames import (
     unit_vector,
     wrap_angle,
 )
-from ._common import angle_function, first_labelled, label, pair, read
+from ._common import angle_function, first_labelled, label, pair, read_input
 
 __all__ = [
     "mounting_azimuth_offset",
@@ -43,8 +44,10 @@ def _declination(declination) -> np.ndarray:
 
 
 def _undefined(A, M, singular_tol: float) -> np.ndarray:
-    """Samples whose azimuth is undefined: zero acceleration or field, or a field
-    parallel to the acceleration (‖A×M‖ ≤ singular_tol·‖A‖‖M‖: no horizontal field).
+    """Flag the samples whose azimuth is undefined.
+
+    Undefined: zero acceleration or field, or a field parallel to the acceleration
+    (‖A×M‖ ≤ singular_tol·‖A‖‖M‖: no horizontal field).
     """
     A, M = np.broadcast_arrays(A, M)
     na = np.linalg.norm(A, axis=-1)
@@ -57,7 +60,7 @@ def _warn_undefined(where: str, bad: np.ndarray, total: int, why: str) -> None:
     warnings.warn(
         f"{where}: {int(np.sum(bad))} of {total} samples set to NaN: {why}",
         RuntimeWarning,
-        stacklevel=4,
+        stacklevel=5,
     )
 
 
@@ -87,9 +90,16 @@ def _azimuth(A, M, declination, singular_tol: float, where: str) -> np.ndarray:
     return wrap_angle(th - declination)
 
 
-def _read_pair(acc, mag):
-    sa = read(acc, "acc")
-    sm = read(pair(acc, mag), "mag")
+def _read_azimuth(acc, mag, convention, declination, singular_tol, where: str):
+    """Read ``acc`` and ``mag`` and compute Eq. 5: the first step of azimuth and heading.
+
+    Returns the azimuth (rad), the acceleration in Benhamou's sign, the signal to label
+    the outputs like, and the checked ``singular_tol``.
+    """
+    singular_tol = _v.positive(singular_tol, "singular_tol")
+    decl = _declination(declination)
+    sa = read_input(acc, "acc")
+    sm = read_input(pair(acc, mag), "mag")
     try:
         np.broadcast_shapes(sa.values.shape, sm.values.shape)
     except ValueError:
@@ -97,7 +107,9 @@ def _read_pair(acc, mag):
             f"acc and mag must have the same number of samples (or broadcast), got "
             f"shapes {sa.values.shape} and {sm.values.shape}"
         ) from None
-    return sa, sm
+    A = _as_benhamou(sa.values, convention)
+    th = _azimuth(A, sm.values, decl, singular_tol, where)
+    return th, A, first_labelled(sa, sm), singular_tol
 
 
 def mounting_azimuth_offset(
@@ -140,8 +152,9 @@ def azimuth(
     declination=0.0,
     singular_tol: float = 1e-9,
 ) -> np.ndarray:
-    r"""Body azimuth θ (ccw from East, rad) from body-frame static acceleration and
-    magnetic field, Eq. 5.
+    r"""Compute the body azimuth θ (ccw from East, rad) by Eq. 5.
+
+    From body-frame static acceleration and magnetic field:
 
     .. math::
         \theta = \mathrm{atan2}\big((A_V^2+A_W^2)M_U - A_U(A_V M_V + A_W M_W),\;
@@ -170,21 +183,34 @@ def azimuth(
         None).
     mag : xarray.DataArray or array_like (..., 3), optional
         Calibrated magnetic field in the same frame (any unit).
+    convention : {"tiltlab", "benhamou"}, optional
+        Sign convention of ``acc``: specific force (``"tiltlab"``, default) or
+        Benhamou's acceleration.
+    declination : float or array_like, optional
+        Magnetic declination (rad, positive East) subtracted from the result
+        (default 0: magnetic azimuth).
+    singular_tol : float, optional
+        Relative threshold (> 0) for the singular (surge vertical) and undefined
+        cases (default 1e-9).
+
+    Returns
+    -------
+    numpy.ndarray or xarray.DataArray
+        Azimuth θ in rad, in (−π, π], one per sample; a DataArray named ``azimuth``
+        for labelled input.
     """
-    singular_tol = _v.positive(singular_tol, "singular_tol")
-    decl = _declination(declination)
-    sa, sm = _read_pair(acc, mag)
-    th = _azimuth(
-        _as_benhamou(sa.values, convention), sm.values, decl, singular_tol, "azimuth"
+    th, _, like, _ = _read_azimuth(
+        acc, mag, convention, declination, singular_tol, "azimuth"
     )
-    return label(th, first_labelled(sa, sm), "azimuth", "rad")
+    return label(th, like, "azimuth", "rad")
 
 
 def collar_azimuth(
     acc, mag=None, *, convention: Convention = "tiltlab", declination=0.0
 ) -> np.ndarray:
-    r"""Eq. 18: azimuth of a collar-mounted device from *device* static acceleration
-    and mean field.
+    r"""Compute the azimuth of a collar-mounted device (Eq. 18).
+
+    From *device* static acceleration and mean field.
 
     Same expression as Eq. 5 applied to :math:`\bar{\mathbf a}, \bar{\mathbf m}`
     (device frame): valid for the body when the animal moves unbanked and the device
@@ -218,8 +244,9 @@ def heading(
     declination=0.0,
     singular_tol: float = 1e-9,
 ) -> Orientation:
-    """Full 3-D orientation (θ Eq. 5, φ Eq. 3a, λ Eq. 3b) with the §3 fallback
-    (pseudo-bank 0) at φ = ±π/2.
+    """Compute the full 3-D orientation (θ Eq. 5, φ Eq. 3a, λ Eq. 3b).
+
+    With the §3 fallback (pseudo-bank 0) at φ = ±π/2.
 
     Inputs as for :func:`azimuth` (``heading(rec)`` reads a Recording's ``acc`` and
     ``mag``). Returns an :class:`~tiltlab.frames.Orientation` in radians (DataArrays
@@ -244,12 +271,21 @@ def heading(
     -------
     Orientation
         Azimuth θ, elevation φ and bank λ (rad).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from tiltlab import trig
+    >>> th, ph, la = np.radians([40.0, 20.0, -10.0])
+    >>> acc = trig.acc_from_angles(ph, la)  # a body at rest
+    >>> mag = trig.mag_from_angles(th, ph, la)  # in the default geomagnetic field
+    >>> o = trig.heading(acc, mag)
+    >>> [float(np.round(np.degrees(v), 1)) for v in o]
+    [40.0, 20.0, -10.0]
     """
-    singular_tol = _v.positive(singular_tol, "singular_tol")
-    decl = _declination(declination)
-    sa, sm = _read_pair(acc, mag)
-    A = _as_benhamou(sa.values, convention)
-    th = _azimuth(A, sm.values, decl, singular_tol, "heading")
+    th, A, like, singular_tol = _read_azimuth(
+        acc, mag, convention, declination, singular_tol, "heading"
+    )
     el, bk = _elev_bank(A)
     sing = np.hypot(A[..., 1], A[..., 2]) < singular_tol * np.linalg.norm(A, axis=-1)
     el = np.where(sing, np.where(A[..., 0] >= 0, -np.pi / 2, np.pi / 2), el)
@@ -257,7 +293,6 @@ def heading(
     zero = np.linalg.norm(A, axis=-1) == 0  # (already warned about by _azimuth)
     el = np.where(zero, np.nan, el)
     bk = np.where(zero, np.nan, bk)
-    like = first_labelled(sa, sm)
     return Orientation(
         label(th, like, "azimuth", "rad"),
         label(el, like, "elevation", "rad"),
@@ -267,7 +302,9 @@ def heading(
 
 @angle_function("azimuth")
 def body_azimuth_from_device(device_azimuth, elevation, bank, phi_star) -> np.ndarray:
-    r"""§3 alternative to Eq. 5: :math:`\theta=\theta^d-\mathrm{atan2}(c_2,c_1)`,
+    r"""Compute the azimuth by the §3 alternative to Eq. 5.
+
+    :math:`\theta=\theta^d-\mathrm{atan2}(c_2,c_1)`,
     :math:`(c_1,c_2,c_3)^\top=R_2(\phi)R_1(\lambda)[0\bullet\phi^*]^\top`.
 
     θ^d is the device azimuth (Eq. 18 on device vectors), φ, λ the body posture and
@@ -299,8 +336,9 @@ def body_azimuth_from_device(device_azimuth, elevation, bank, phi_star) -> np.nd
 
 @angle_function("azimuth")
 def apply_declination(magnetic_azimuth, declination) -> np.ndarray:
-    """True azimuth = magnetic azimuth − declination (rad, declination positive East),
-    wrapped to (−π, π].
+    """Convert a magnetic azimuth to a true azimuth (rad), wrapped to (−π, π].
+
+    True azimuth = magnetic azimuth − declination (declination positive East).
 
     Parameters
     ----------

@@ -9,16 +9,16 @@ from __future__ import annotations
 
 import numpy as np
 
-from .. import _validate as _v
+import tiltlab._validate as _v
 from ..dsp import moving_mean, window_samples
-from ._common import read, start_time, windowed
+from ._common import read_input, start_time, windowed
 from ._types import OscillationStats
 
 __all__ = ["crossing_times", "oscillation_stats"]
 
 
 def _read_signal(signal, fs):
-    return read(signal, "signal", fs=fs, need_fs=True, width=None, ndim=1)
+    return read_input(signal, "signal", fs=fs, need_fs=True, width=None, ndim=1)
 
 
 def _crossings(x: np.ndarray, fs: float) -> np.ndarray:
@@ -35,8 +35,9 @@ def _crossings(x: np.ndarray, fs: float) -> np.ndarray:
 
 
 def crossing_times(signal, fs=None, *, level: float = 0.0) -> np.ndarray:
-    """Times (s) at which ``signal`` crosses ``level`` (either direction), linearly
-    interpolated between samples.
+    """Find the times (s) at which ``signal`` crosses ``level`` (either direction).
+
+    Linearly interpolated between samples.
 
     Parameters
     ----------
@@ -67,8 +68,10 @@ def oscillation_stats(
     window_s: float,
     smooth_s: float | None = None,
 ) -> OscillationStats:
-    r"""Per Δt window: mean delay d̄ between successive crossings of a balance level,
-    its CV, and period T = 2d̄ (§9).
+    r"""Compute crossing statistics per Δt window (§9).
+
+    The mean delay d̄ between successive crossings of a balance level, its CV, and the
+    period T = 2d̄.
 
     For a regular oscillation CV ≪ 1; for random fluctuations the delays are close
     to exponential (CV ≈ 1). The balance level is the static value of the signal,

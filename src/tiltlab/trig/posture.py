@@ -11,9 +11,9 @@ import warnings
 
 import numpy as np
 
-from .. import _validate as _v
+import tiltlab._validate as _v
 from ..frames import Convention, _as_benhamou, _clip1, _elev_bank, acc_from_angles
-from ._common import angle_function, label, read
+from ._common import angle_function, label, read_input
 from ._types import Posture
 
 __all__ = [
@@ -56,8 +56,19 @@ def posture(acc, *, convention: Convention = "tiltlab") -> Posture:
     -------
     Posture
         Angles in radians (DataArrays with ``time``/``fs`` for labelled input).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from tiltlab import trig
+    >>> acc = trig.acc_from_angles(np.radians(20.0), np.radians(-10.0))
+    >>> p = trig.posture(acc)
+    >>> p._fields
+    ('elevation', 'bank', 'inclination', 'orientation')
+    >>> [float(np.round(np.degrees(v), 1)) for v in p]
+    [20.0, -10.0, 22.3, -25.5]
     """
-    s = read(acc, "acc")
+    s = read_input(acc, "acc")
     A = _as_benhamou(s.values, convention)
     el, bk = _elev_bank(A)
     zeta = np.arctan2(np.hypot(A[..., 0], A[..., 1]), -A[..., 2])
@@ -72,7 +83,7 @@ def posture(acc, *, convention: Convention = "tiltlab") -> Posture:
 
 
 def _nan_where_zero(V, where: str, name: str, *angles):
-    """The angles, NaN (with a RuntimeWarning) where the vector ``V`` is zero."""
+    """Return the angles, NaN (with a RuntimeWarning) where the vector ``V`` is zero."""
     zero = np.all(V == 0, axis=-1)
     if not np.any(zero):
         return angles
@@ -87,7 +98,8 @@ def _nan_where_zero(V, where: str, name: str, *angles):
 
 @angle_function(("inclination", "orientation"))
 def inclination_from_angles(elevation, bank) -> tuple[np.ndarray, np.ndarray]:
-    r"""(ζ, χ) from (φ, λ):
+    r"""Convert (φ, λ) to (ζ, χ).
+
     :math:`[\chi\bullet(\pi/2-\zeta)] = (\sin\phi, \cos\phi\sin\lambda,
     \cos\phi\cos\lambda)`.
 
@@ -114,7 +126,9 @@ def inclination_from_angles(elevation, bank) -> tuple[np.ndarray, np.ndarray]:
 
 @angle_function(("elevation", "bank"))
 def angles_from_inclination(inclination, orientation) -> tuple[np.ndarray, np.ndarray]:
-    r"""(φ, λ) from (ζ, χ): :math:`\phi=\sin^{-1}(\sin\zeta\cos\chi)`,
+    r"""Convert (ζ, χ) to (φ, λ).
+
+    :math:`\phi=\sin^{-1}(\sin\zeta\cos\chi)`,
     :math:`\lambda=\mathrm{atan2}(\sin\zeta\sin\chi,\cos\zeta)`.
 
     Parameters
@@ -140,7 +154,8 @@ def angles_from_inclination(inclination, orientation) -> tuple[np.ndarray, np.nd
 
 @angle_function("elevation", angles=("elevation",))
 def correct_tangential(elevation, tangential_acc, *, g: float = 9.81) -> np.ndarray:
-    r"""Elevation corrected for a sustained forward acceleration h = Δv/Δt (§2):
+    r"""Correct the elevation for a sustained forward acceleration h = Δv/Δt (§2).
+
     :math:`\phi - \tan^{-1}(h/g)`.
 
     ``tangential_acc`` and ``g`` in the same units; h < 0 for a deceleration.
@@ -167,7 +182,8 @@ def correct_tangential(elevation, tangential_acc, *, g: float = 9.81) -> np.ndar
 
 @angle_function("bank", angles=("bank",))
 def correct_centripetal(bank, speed, curvature, *, g: float = 9.81) -> np.ndarray:
-    r"""Bank corrected for a sustained horizontal turn (§2):
+    r"""Correct the bank for a sustained horizontal turn (§2).
+
     :math:`\lambda - \tan^{-1}(v^2\kappa/g)`.
 
     ``curvature`` κ = 1/r is signed, positive for a left (counter-clockwise) turn,
@@ -196,8 +212,9 @@ def correct_centripetal(bank, speed, curvature, *, g: float = 9.81) -> np.ndarra
 
 
 def magnetic_posture(mag) -> tuple[np.ndarray, np.ndarray]:
-    r"""Magnetic 'elevation' and 'bank' :math:`\sin^{-1}(-M_U/\|\mathbf M\|)`,
-    :math:`\mathrm{atan2}(-M_V,-M_W)` (§3).
+    r"""Compute the magnetic 'elevation' and 'bank' (§3).
+
+    :math:`\sin^{-1}(-M_U/\|\mathbf M\|)`, :math:`\mathrm{atan2}(-M_V,-M_W)`.
 
     Insensitive to dynamic acceleration, but measured against the plane orthogonal
     to the (dipping) field, hence hard to interpret on its own. ``mag``: a Recording
@@ -216,7 +233,7 @@ def magnetic_posture(mag) -> tuple[np.ndarray, np.ndarray]:
     magnetic_bank : ndarray or xarray.DataArray
         Magnetic 'bank' (rad).
     """
-    s = read(mag, "mag")
+    s = read_input(mag, "mag")
     el, bk = _elev_bank(s.values)
     el, bk = _nan_where_zero(s.values, "magnetic_posture", "mag", el, bk)
     return label(el, s, "magnetic_elevation", "rad"), label(
@@ -227,8 +244,9 @@ def magnetic_posture(mag) -> tuple[np.ndarray, np.ndarray]:
 def posture_from_magnetic_loop(
     mag_loop, inclination: float
 ) -> tuple[float, float, float]:
-    r"""Posture of a bird looping in a thermal from magnetic vectors sampled evenly
-    over one loop (§3).
+    r"""Compute the posture of a bird looping in a thermal (§3).
+
+    From magnetic vectors sampled evenly over one loop.
 
     With :math:`\Sigma\mathbf M` the sum of the body-frame field vectors and I the
     geomagnetic dip (rad, positive downward):
@@ -260,7 +278,7 @@ def posture_from_magnetic_loop(
         If the field vectors sum to zero.
     """
     inclination = _v.finite(inclination, "inclination")
-    m = read(mag_loop, "mag_loop", var="mag", allow_nan=False).values
+    m = read_input(mag_loop, "mag_loop", var="mag", allow_nan=False).values
     s = m.reshape(-1, 3).sum(axis=0)
     n = np.linalg.norm(s)
     if n == 0:

@@ -1,5 +1,6 @@
-r"""Body rotations from the gyroscope and their relation to changes of orientation
-(Benhamou 2023 §4, §6, Eqs. 10–13; App. B head relative to body; App. C cap passage).
+r"""Body rotations from the gyroscope and their relation to changes of orientation.
+
+Benhamou 2023 §4, §6, Eqs. 10–13; App. B head relative to body; App. C cap passage.
 
 :func:`body_rotations` takes per-sample angular velocity: a Recording (variable
 ``gyr``), a labelled DataArray or a plain array with ``fs`` and ``units``; units are
@@ -13,7 +14,7 @@ from typing import Literal
 
 import numpy as np
 
-from .. import _validate as _v
+import tiltlab._validate as _v
 from ..dsp import window_samples
 from ..frames import (
     R1,
@@ -26,7 +27,7 @@ from ..frames import (
     unit_vector,
     wrap_angle,
 )
-from ._common import angle_function, read, windowed
+from ._common import angle_function, read_input, windowed
 from ._types import Rotations
 from .arcs import arc, interpolate_heading
 
@@ -51,8 +52,9 @@ __all__ = [
 def body_rotations(
     gyr, fs=None, *, window_s: float, units: str | None = None
 ) -> Rotations:
-    r"""Yaw, pitch, roll per Δt step: :math:`\alpha_i=\sum_j\dot\alpha_{i,j}/f` etc. over
-    k = round(fΔt) samples (§4).
+    r"""Compute yaw, pitch and roll per Δt step (§4).
+
+    :math:`\alpha_i=\sum_j\dot\alpha_{i,j}/f` etc. over k = round(fΔt) samples.
 
     With (ρ̇, β̇, α̇) = (ω_x, −ω_y, ω_z) from tiltlab's body-frame angular velocity ω.
     Non-overlapping blocks; a trailing incomplete block is dropped.
@@ -76,7 +78,9 @@ def body_rotations(
         Radians per step; for labelled input, DataArrays over the step-centre times
         with ``fs`` = steps per second.
     """
-    s = read(gyr, "gyr", fs=fs, units=units, to_units="rad/s", need_fs=True, ndim=2)
+    s = read_input(
+        gyr, "gyr", fs=fs, units=units, to_units="rad/s", need_fs=True, ndim=2
+    )
     k = window_samples(window_s, s.fs)
     g = s.values
     nb = g.shape[0] // k
@@ -226,10 +230,9 @@ def rotations_from_orientations(
 
     Parameters
     ----------
-    az0, el0, bank0 : float or array_like
-        Azimuth, elevation and bank (rad) at the start of the step.
-    az1, el1, bank1 : float or array_like
-        Azimuth, elevation and bank (rad) at the end of the step.
+    az0, el0, bank0, az1, el1, bank1 : float or array_like
+        Azimuth, elevation and bank (rad) at the start (0) and the end (1) of the step;
+        they broadcast.
     method : {"simultaneous", "sequential"}
         Eq. 11 simultaneous rotations (default) or Eq. 10 yaw-then-pitch decomposition.
 
@@ -364,7 +367,10 @@ def compose_sub_arcs(
     roll: float,
     k: int,
 ) -> np.ndarray:
-    r"""Final body→world matrix after k blocks of (roll ρ/k about surge, yaw α_{i,j} about heave, pitch β_{i,j} about sway).
+    r"""Compute the final body→world matrix after k blocks of sub-arc rotations.
+
+    Each block is a roll ρ/k about surge, a yaw α_{i,j} about heave and a pitch
+    β_{i,j} about sway.
 
     Rotations are intrinsic (body axes): :math:`C \leftarrow C\,R_1(\rho/k)\,R_3(\alpha_{i,j})\,R_2(\beta_{i,j})`
     (Benhamou's :math:`R_2` makes a positive pitch raise the nose).
@@ -373,14 +379,8 @@ def compose_sub_arcs(
     ----------
     az0, el0, bank0 : float
         Azimuth, elevation and bank (rad) at the start of the step.
-    size : float
-        Arc size ω (rad).
-    eta_initial : float
-        Initial body-relative inclination η^i (rad).
-    roll : float
-        Total roll ρ (rad) over the step.
-    k : int
-        Number of sub-arcs (blocks), ≥ 1.
+    size, eta_initial, roll, k
+        The step and its number of sub-arcs, as for :func:`sub_arc_rotations`.
 
     Returns
     -------
@@ -457,12 +457,9 @@ def step_body_rates(
 
     Parameters
     ----------
-    size : float
-        Arc size ω (rad).
-    eta_initial : float
-        Initial body-relative inclination η^i (rad).
-    roll : float
-        Total roll ρ (rad) over the step.
+    size, eta_initial, roll : float
+        Arc size ω, initial body-relative inclination η^i and total roll ρ (rad) of
+        the step (see :func:`exact_step`).
     duration_s : float
         Step duration Δt (s), > 0.
     n : int
