@@ -159,7 +159,7 @@ def test_recording_speed_offsets():
     from tiltlab.simulate import simulate_session
 
     rec = simulate_session(20.0, 100.0, seed=4, keep_true=True)
-    raw = B.recording_speed(rec, offset=None)
+    raw = B.recording_speed(rec, gyr_offset=None)
     np.testing.assert_allclose(raw, np.linalg.norm(rec["gyr"].values, axis=1))
     true = np.linalg.norm(rec["gyr_true"].values, axis=1)
     # "auto": the quietest-window estimate (calibration.robust_gyro_offset), never the truth
@@ -173,7 +173,7 @@ def test_recording_speed_offsets():
     )
     np.testing.assert_array_equal(B.recording_speed(blind).values, auto.values)
     with pytest.raises(ValueError, match="'auto'"):
-        B.recording_speed(rec, offset="median")
+        B.recording_speed(rec, gyr_offset="median")
 
 
 # ---------------------------------------------------------------------------
@@ -333,7 +333,7 @@ def test_a_missing_fs_is_an_error_naming_fs():
     with pytest.raises(RecordingError, match="fs"):
         B.immobility(rec, 200.0)
     # speed without an offset estimate needs no fs
-    assert B.recording_speed(no_fs, offset=None).shape == (rec.sizes["time"],)
+    assert B.recording_speed(no_fs, gyr_offset=None).shape == (rec.sizes["time"],)
 
 
 def test_a_missing_or_contradictory_unit_is_an_error_naming_it():

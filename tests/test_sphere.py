@@ -128,7 +128,7 @@ def test_locate_matches_brute_force_on_1e5_vectors_with_edges_and_vertices():
     f = rng.integers(0, m.n_faces, 20_000)
     k = rng.integers(0, 3, 20_000)
     a, b = m.vertices[m.faces[f, k]], m.vertices[m.faces[f, (k + 1) % 3]]
-    X[:20_000] = S.slerp(a, b, rng.random(20_000))
+    X[:20_000] = S.slerp_vectors(a, b, rng.random(20_000))
     X[20_000:25_000] = m.vertices[rng.integers(0, m.n_vertices, 5000)]
     got = S.locate(X, m)
     ref, cnt = brute_locate(m, X)
@@ -392,7 +392,9 @@ def test_mkde_mass_along_arcs_and_time_weighting():
     lk = S.kde(x, grid=grid, h=0.05)
     assert mk.integral() == pytest.approx(1.0, abs=1e-3)
     mid = np.argmin(
-        np.linalg.norm(grid.centres().reshape(-1, 3) - S.slerp(a, b, 0.5), axis=1)
+        np.linalg.norm(
+            grid.centres().reshape(-1, 3) - S.slerp_vectors(a, b, 0.5), axis=1
+        )
     )
     assert (
         mk.density.ravel()[mid] > 0.5 / (1.0 * 1.0) and lk.density.ravel()[mid] < 1e-6

@@ -1,5 +1,6 @@
-r"""Behavioural read-outs from head inertial data: angular speed, immobility, circling,
-activity.
+r"""Compute behavioural read-outs from head inertial data.
+
+Angular speed, immobility, circling and activity:
 
 * :mod:`~tiltlab.behavior.speed` — angular speed, its still/moving modes and valley,
   gyroscope spectrum, realism table (Fayat et al. 2021 §2.9, Fig. A3);

@@ -1,5 +1,6 @@
-r"""Activity from the accelerometer: static acceleration, DBA/ODBA and one value per
-step (Benhamou 2023 §2, §9; Qasem et al. 2012).
+r"""Measure activity from the accelerometer (Benhamou 2023 §2, §9; Qasem et al. 2012).
+
+Static acceleration, DBA/ODBA and one value per step.
 
 The static acceleration :math:`\bar{\mathbf a}` is the per-axis mean over a Δt window;
 the dynamic body acceleration (vectorial DBA, VeDBA) is
@@ -22,7 +23,7 @@ from typing import Literal, NamedTuple
 import numpy as np
 
 from ..dsp import window_samples
-from ._common import label, read, start_time, windowed
+from ._common import label, read_behavior_input, start_time, windowed
 
 __all__ = [
     "window_length",
@@ -35,8 +36,9 @@ __all__ = [
 
 
 class StepSummary(NamedTuple):
-    """One value per Δt step (§9): centre time (s), static acceleration (n, 3), mean
-    DBA.
+    """One value per Δt step (§9).
+
+    Centre time (s), static acceleration (n, 3) and mean DBA.
     """
 
     time: np.ndarray
@@ -45,7 +47,7 @@ class StepSummary(NamedTuple):
 
 
 def window_length(window_s: float, fs: float) -> int:
-    """Number of samples k = round(f Δt) of a Δt window (at least 1).
+    """Count the samples k = round(f Δt) of a Δt window (at least 1).
 
     Parameters
     ----------
@@ -64,12 +66,13 @@ def window_length(window_s: float, fs: float) -> int:
 
 def _read_acc(acc, fs):
     # NaN marks a gap of a recording read with gaps="nan"; windows touching it are NaN
-    return read(acc, "acc", fs=fs, need_fs=True, allow_nan=True)
+    return read_behavior_input(acc, "acc", fs=fs, need_fs=True, allow_nan=True)
 
 
 def _sliding_mean(a: np.ndarray, k: int) -> np.ndarray:
-    """Centred window of k samples, truncated at the ends; NaN where the window holds
-    a non-finite sample (a gap), finite elsewhere.
+    """Return the mean over a centred window of k samples, truncated at the ends.
+
+    NaN where the window holds a non-finite sample (a gap), finite elsewhere.
     """
     n = a.shape[0]
     before = k // 2
@@ -94,7 +97,9 @@ def static_acceleration(
     window_s: float,
     mode: Literal["sliding", "jumping"] = "sliding",
 ):
-    r"""Static acceleration :math:`\bar{\mathbf a}`: per-axis mean over a Δt window (§2).
+    r"""Compute the static acceleration :math:`\bar{\mathbf a}` over a Δt window (§2).
+
+    It is the per-axis mean over the window.
 
     ``"sliding"``: centred window of k = round(fΔt) samples attributed to its centre
     ((k−1)/2 samples either side for odd k; k/2 before and (k−2)/2 after for even k);
@@ -115,6 +120,7 @@ def static_acceleration(
     window_s : float
         Window duration Δt (s).
     mode : {"sliding", "jumping"}
+        Sliding (one value per sample) or jumping (one per block) window.
 
     Returns
     -------
@@ -126,6 +132,18 @@ def static_acceleration(
     ------
     ValueError
         If ``mode`` is neither ``"sliding"`` nor ``"jumping"``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from tiltlab import behavior
+    >>> t = np.arange(400) / 100.0
+    >>> acc = np.column_stack([np.sin(2 * np.pi * 5 * t), 0 * t, 1 + 0 * t])  # g
+    >>> stat = behavior.static_acceleration(acc, 100.0, window_s=0.2)
+    >>> np.round(stat[200], 3)
+    array([0., 0., 1.])
+    >>> behavior.static_acceleration(acc, 100.0, window_s=0.2, mode="jumping").shape
+    (20, 3)
     """
     if mode not in ("sliding", "jumping"):
         raise ValueError(f"mode must be 'sliding' or 'jumping', got {mode!r}")
@@ -147,9 +165,17 @@ def static_acceleration(
     return label(_sliding_mean(a, k), s, "static_acceleration", s.units)
 
 
+def _dynamic(acc, fs, window_s: float):
+    """Return the Signal read from ``acc`` and its dynamic part a − ā per sample."""
+    s = _read_acc(acc, fs)
+    a = s.values
+    return s, a - _sliding_mean(a, window_samples(window_s, s.fs))
+
+
 def dba(acc, fs=None, *, window_s: float):
-    r"""Dynamic body acceleration :math:`\|\mathbf a - \bar{\mathbf a}\|` per sample
-    (vectorial DBA, VeDBA [2]_).
+    r"""Compute the dynamic body acceleration :math:`\|\mathbf a - \bar{\mathbf a}\|`.
+
+    One value per sample (vectorial DBA, VeDBA [2]_).
 
     Posture-independent: it is invariant to any rotation of the device. Same units as
     ``acc``; see :func:`static_acceleration` for the inputs.
@@ -168,41 +194,34 @@ def dba(acc, fs=None, *, window_s: float):
     numpy.ndarray or xarray.DataArray (N,)
         DBA per sample, in the units of ``acc``; NaN where the window touches a gap.
     """
-    s = _read_acc(acc, fs)
-    a = s.values
-    d = np.linalg.norm(a - _sliding_mean(a, window_samples(window_s, s.fs)), axis=-1)
-    return label(d, s, "dba", s.units)
+    s, dyn = _dynamic(acc, fs, window_s)
+    return label(np.linalg.norm(dyn, axis=-1), s, "dba", s.units)
 
 
 def odba(acc, fs=None, *, window_s: float):
-    r"""Overall DBA :math:`|d_U|+|d_V|+|d_W|` per sample (Wilson et al. 2006).
+    r"""Compute the overall DBA :math:`|d_U|+|d_V|+|d_W|` per sample (Wilson et al. 2006).
 
     Shown for comparison only: it depends on the device orientation (it is not
     rotation invariant), unlike :func:`dba`.
 
     Parameters
     ----------
-    acc : xarray.Dataset, xarray.DataArray or array_like (N, 3)
-        Acceleration (any unit, kept), e.g. in g or m/s².
-    fs : float, optional
-        Sampling rate (Hz) of a plain array; read from the attributes when labelled.
-    window_s : float
-        Window duration Δt (s) of the sliding static-acceleration mean.
+    acc, fs, window_s : array_like (N, 3), float, float
+        As in :func:`dba`: the acceleration (a Recording, a labelled DataArray or a
+        plain array with ``fs``), its sampling rate and the window (s) of the static
+        acceleration.
 
     Returns
     -------
     numpy.ndarray or xarray.DataArray (N,)
         ODBA per sample, in the units of ``acc``; NaN where the window touches a gap.
     """
-    s = _read_acc(acc, fs)
-    a = s.values
-    d = np.abs(a - _sliding_mean(a, window_samples(window_s, s.fs))).sum(axis=-1)
-    return label(d, s, "odba", s.units)
+    s, dyn = _dynamic(acc, fs, window_s)
+    return label(np.abs(dyn).sum(axis=-1), s, "odba", s.units)
 
 
 def step_summary(acc, fs=None, *, window_s: float) -> StepSummary:
-    r"""Keep one value per Δt step (§9): subsampled static acceleration and averaged
-    DBA.
+    r"""Keep one value per Δt step (§9): subsampled static acceleration, averaged DBA.
 
     The sliding-window :math:`\bar{\mathbf a}` is subsampled at the centre sample of
     each consecutive block of k = round(fΔt) samples, and the per-sample DBA is
@@ -211,10 +230,9 @@ def step_summary(acc, fs=None, *, window_s: float) -> StepSummary:
 
     Parameters
     ----------
-    acc : xarray.Dataset, xarray.DataArray or array_like (N, 3)
-        Acceleration (any unit, kept), e.g. in g or m/s².
-    fs : float, optional
-        Sampling rate (Hz) of a plain array; read from the attributes when labelled.
+    acc, fs : array_like (N, 3), float
+        As in :func:`dba`: the acceleration (a Recording, a labelled DataArray or a
+        plain array with ``fs``) and its sampling rate.
     window_s : float
         Step duration Δt (s); k = round(fΔt) samples per step.
 

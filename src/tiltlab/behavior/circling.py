@@ -15,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 
 from .. import _validate as _v
-from ._common import label, need_gyr, read
+from ._common import label, need_gyr, read_behavior_input
 
 __all__ = ["azimuthal_speed", "circling_index"]
 
@@ -27,8 +27,8 @@ def _read_pair(gyr, g, units, what="azimuthal_speed"):
         "the rotation about gravity is not observable from an accelerometer; with a "
         "magnetometer, differentiate the heading (tiltlab.trig) instead",
     )
-    sw = read(gyr, "gyr", units=units, to_units="deg/s", allow_nan=True)
-    sg = read(g, "g", var="gravity", allow_nan=True)
+    sw = read_behavior_input(gyr, "gyr", units=units, to_units="deg/s", allow_nan=True)
+    sg = read_behavior_input(g, "g", var="gravity", allow_nan=True)
     zero = np.sum(sg.values * sg.values, axis=1) == 0  # NaN rows (gaps) pass
     if np.any(zero):
         raise ValueError(
@@ -101,6 +101,11 @@ def circling_index(gyr, g, *, moving=None, units: str | None = None) -> float:
         :func:`~tiltlab.behavior.immobility`); default all.
     units : str, optional
         Units of a plain ``gyr``.
+
+    Returns
+    -------
+    float
+        Circles per minute, counter-clockwise (seen from above) positive.
     """
     az = np.asarray(_azimuthal(gyr, g, units, "circling_index"))
     if moving is not None:

@@ -1,5 +1,6 @@
-r"""Immobility, from the gyroscope (Fayat et al. 2021, §2.9) or, on recordings
-without one, from the accelerometer.
+r"""Detect immobility from the gyroscope or, without one, from the accelerometer.
+
+The gyroscope rule is Fayat et al. 2021, §2.9.
 
 **Gyroscope rule** (Fayat et al. 2021 §2.9). A sample is still when the angular speed
 (norm of the offset-corrected gyroscope, °/s) is below 12 °/s; still periods separated
@@ -51,13 +52,15 @@ References
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 import xarray as xr
 
 from .. import _validate as _v
 from .. import units as _units
 from ..dsp import still_mask, window_samples
-from ._common import label, need_gyr, read, read_speed
+from ._common import label, need_gyr, read_behavior_input, read_speed
 from .activity import _sliding_mean
 from .speed import _offset, _read_gyr, _speed, valley_threshold
 
@@ -65,6 +68,43 @@ __all__ = ["detect_immobility", "immobility", "acc_immobility", "IMMOBILITY_RULE
 
 #: values of ``immobility(..., rule=)``
 IMMOBILITY_RULES = ("auto", "gyroscope", "accelerometer")
+
+
+class _Periods(NamedTuple):
+    """How still samples become still periods: gaps merged, short periods dropped."""
+
+    merge_gap_s: float = 0.1
+    min_duration_s: float = 0.5
+
+    def mask(self, values, fs: float, threshold: float, smooth_s: float = 0.0):
+        """Return the still mask of ``values`` (:func:`tiltlab.dsp.still_mask`)."""
+        return still_mask(
+            values,
+            fs,
+            threshold=threshold,
+            smooth_s=smooth_s,
+            merge_gap_s=self.merge_gap_s,
+            min_duration_s=self.min_duration_s,
+        )
+
+    def attrs(self) -> dict:
+        """Return the settings as attributes of a mask."""
+        return {
+            "merge_gap_s": float(self.merge_gap_s),
+            "min_duration_s": float(self.min_duration_s),
+        }
+
+
+def _rule_attrs(rule: str, thr: float, own: dict, periods: _Periods, text: str):
+    """Return the attributes of an :func:`immobility` mask made by ``rule``."""
+    return {
+        "rule": rule,
+        "threshold": thr,
+        "threshold_units": "deg/s" if rule == "gyroscope" else "g",
+        **own,
+        **periods.attrs(),
+        "rule_description": text,
+    }
 
 
 def _threshold(threshold_deg_s) -> float:
@@ -111,20 +151,10 @@ def detect_immobility(
         ``fs`` and the settings as attributes for labelled input.
     """
     thr = _threshold(threshold_deg_s)
+    periods = _Periods(merge_gap_s, min_duration_s)
     s = read_speed(speed, fs, units=units, need_fs=True)
-    mask = still_mask(
-        s.values,
-        s.fs,
-        threshold=thr,
-        merge_gap_s=merge_gap_s,
-        min_duration_s=min_duration_s,
-    )
-    attrs = {
-        "threshold_deg_s": thr,
-        "threshold_method": "fixed",
-        "merge_gap_s": float(merge_gap_s),
-        "min_duration_s": float(min_duration_s),
-    }
+    mask = periods.mask(s.values, s.fs, thr)
+    attrs = {"threshold_deg_s": thr, "threshold_method": "fixed", **periods.attrs()}
     return label(mask, s, "immobile", attrs=attrs)
 
 
@@ -186,7 +216,9 @@ def acc_immobility(
     """
     thr = _v.positive(threshold_g, "threshold_g")
     smooth_s = _v.nonnegative(smooth_s, "smooth_s")
-    s = read(acc, "acc", fs=fs, units=units, to_units="g", need_fs=True, allow_nan=True)
+    s = read_behavior_input(
+        acc, "acc", fs=fs, units=units, to_units="g", need_fs=True, allow_nan=True
+    )
     a = s.values
     ok = np.isfinite(a).all(axis=1)
     if not ok.any():
@@ -197,33 +229,19 @@ def acc_immobility(
         a = np.column_stack([np.interp(idx, idx[ok], a[ok, k]) for k in range(3)])
     d = np.linalg.norm(a - _sliding_mean(a, window_samples(window_s, s.fs)), axis=1)
     d[~ok] = 1e3 * thr  # far above the threshold: a missing sample is never still
-    mask = still_mask(
-        d,
-        s.fs,
-        threshold=thr,
-        smooth_s=smooth_s,
-        merge_gap_s=merge_gap_s,
-        min_duration_s=min_duration_s,
+    periods = _Periods(merge_gap_s, min_duration_s)
+    mask = periods.mask(d, s.fs, thr, smooth_s)
+    own = {"threshold_g": thr, "window_s": float(window_s), "smooth_s": float(smooth_s)}
+    text = (
+        f"VeDBA ({float(window_s):g} s static window, {smooth_s:g} s running mean) "
+        f"< {thr:g} g"
     )
-    attrs = {
-        "rule": "accelerometer",
-        "threshold": thr,
-        "threshold_units": "g",
-        "threshold_g": thr,
-        "window_s": float(window_s),
-        "smooth_s": float(smooth_s),
-        "merge_gap_s": float(merge_gap_s),
-        "min_duration_s": float(min_duration_s),
-        "rule_description": (
-            f"VeDBA ({float(window_s):g} s static window, {smooth_s:g} s running mean) "
-            f"< {thr:g} g"
-        ),
-    }
+    attrs = _rule_attrs("accelerometer", thr, own, periods, text)
     return label(mask, s, "immobile", attrs=attrs)
 
 
 def _choose_rule(data, rule: str, units: str | None) -> str:
-    """The rule :func:`immobility` applies to ``data``."""
+    """Return the rule :func:`immobility` applies to ``data``."""
     if not isinstance(rule, str) or rule not in IMMOBILITY_RULES:
         raise ValueError(f"rule must be one of {IMMOBILITY_RULES}, got {rule!r}")
     if rule != "auto":
@@ -260,15 +278,12 @@ def immobility(
     rule: str = "auto",
     threshold_deg_s: float | str = 12.0,
     gyr_offset=None,
-    threshold_g: float = 0.03,
-    window_s: float = 0.5,
-    smooth_s: float = 0.2,
     merge_gap_s: float = 0.1,
     min_duration_s: float = 0.5,
     units: str | None = None,
+    **acc_rule,
 ):
-    """Immobility mask: the gyroscope rule when there is a gyroscope, else the
-    accelerometer rule.
+    """Detect immobility with the gyroscope rule, or the accelerometer rule without one.
 
     Parameters
     ----------
@@ -290,14 +305,15 @@ def immobility(
     gyr_offset : "auto", None or array_like (3,)
         Gyroscope rule: offset subtracted first, in the units of ``gyr``; ``"auto"``:
         :func:`tiltlab.calibration.robust_gyro_offset`.
-    threshold_g, window_s, smooth_s : float
-        Accelerometer rule (:func:`acc_immobility`): VeDBA threshold (g), static window
-        (s) and running mean (s).
     merge_gap_s, min_duration_s : float
         Both rules; see :func:`detect_immobility`.
     units : str, optional
         Units of a plain array ('deg/s' or 'rad/s' for a gyroscope, 'g' or 'm/s^2' for
         an accelerometer).
+    **acc_rule
+        Accelerometer rule (:func:`acc_immobility`): ``threshold_g`` (VeDBA threshold,
+        g; default 0.03), ``window_s`` (static window, s; 0.5) and ``smooth_s``
+        (running mean, s; 0.2).
 
     Returns
     -------
@@ -315,30 +331,46 @@ def immobility(
 
     Examples
     --------
+    A head still for 2 s, then turning in place (about gravity) at 90 °/s:
+
     >>> import numpy as np
     >>> from tiltlab import behavior, schema
-    >>> acc = np.tile([0.0, 0.0, 1.0], (500, 1))
-    >>> rec = schema.make_recording(acc, fs=100.0, acc_units="g")  # no gyroscope
+    >>> gyr = np.zeros((400, 3))
+    >>> gyr[200:, 2] = 90.0
+    >>> acc = np.tile([0.0, 0.0, 1.0], (400, 1))
+    >>> rec = schema.make_recording(
+    ...     acc, gyr, fs=100.0, acc_units="g", gyr_units="deg/s"
+    ... )
     >>> still = behavior.immobility(rec)
-    >>> still.attrs["rule"], still.attrs["threshold_units"], bool(still.all())
-    ('accelerometer', 'g', True)
+    >>> still.attrs["rule_description"]
+    'angular speed < 12 deg/s (fixed)'
+    >>> bool(still[:150].all()), bool(still[250:].any())
+    (True, False)
+
+    The accelerometer rule (the only one without a gyroscope) misses the turn:
+
+    >>> by_acc = behavior.immobility(rec, rule="accelerometer")
+    >>> by_acc.attrs["threshold_units"], bool(by_acc.all())
+    ('g', True)
     """
     if isinstance(threshold_deg_s, str) and threshold_deg_s != "auto":
         raise ValueError(
             f"threshold_deg_s must be a number of °/s or 'auto', got {threshold_deg_s!r}"
         )
-    chosen = _choose_rule(data, rule, units)
-    if chosen == "accelerometer":
-        return acc_immobility(
-            data,
-            fs,
-            threshold_g=threshold_g,
-            window_s=window_s,
-            smooth_s=smooth_s,
-            merge_gap_s=merge_gap_s,
-            min_duration_s=min_duration_s,
-            units=units,
+    unknown = sorted(set(acc_rule) - {"threshold_g", "window_s", "smooth_s"})
+    if unknown:
+        raise TypeError(
+            f"immobility() got an unexpected keyword argument {unknown[0]!r}"
         )
+    chosen = _choose_rule(data, rule, units)
+    periods = _Periods(merge_gap_s, min_duration_s)
+    if chosen == "accelerometer":
+        return acc_immobility(data, fs, **periods._asdict(), units=units, **acc_rule)
+    return _gyro_immobility(data, fs, units, threshold_deg_s, gyr_offset, periods)
+
+
+def _gyro_immobility(data, fs, units, threshold_deg_s, gyr_offset, periods: _Periods):
+    """Apply the gyroscope rule of :func:`immobility`."""
     need_gyr(data, "immobility(rule='gyroscope')", "use rule='accelerometer'")
     s = _read_gyr(data, fs, units, need_fs=True)
     speed = _speed(s, _offset(s, gyr_offset, "gyr_offset"))
@@ -349,21 +381,8 @@ def immobility(
         )
     else:
         thr, method = _threshold(threshold_deg_s), "fixed"
-    mask = detect_immobility(
-        speed,
-        s.fs,
-        threshold_deg_s=thr,
-        merge_gap_s=merge_gap_s,
-        min_duration_s=min_duration_s,
-    )
-    attrs = {
-        "rule": "gyroscope",
-        "threshold": thr,
-        "threshold_units": "deg/s",
-        "threshold_deg_s": thr,
-        "threshold_method": method,
-        "merge_gap_s": float(merge_gap_s),
-        "min_duration_s": float(min_duration_s),
-        "rule_description": f"angular speed < {thr:g} deg/s ({method})",
-    }
+    mask = detect_immobility(speed, s.fs, threshold_deg_s=thr, **periods._asdict())
+    own = {"threshold_deg_s": thr, "threshold_method": method}
+    text = f"angular speed < {thr:g} deg/s ({method})"
+    attrs = _rule_attrs("gyroscope", thr, own, periods, text)
     return label(np.asarray(mask), s, "immobile", attrs=attrs)

@@ -1,5 +1,7 @@
-"""Side-by-side activity statistics of recordings: how a simulated session compares with
-a real one (:func:`realism_table`), by the gyroscope or, without one, the accelerometer.
+"""Side-by-side activity statistics of recordings.
+
+How a simulated session compares with a real one (:func:`realism_table`), by the
+gyroscope or, without one, the accelerometer.
 """
 
 from __future__ import annotations
@@ -8,7 +10,8 @@ import numpy as np
 import pandas as pd
 
 from .. import _validate as _v
-from ._common import need_gyr, read
+from .._labels import label_columns
+from ._common import need_gyr, read_behavior_input
 from .immobility import acc_immobility
 from .speed import NO_GYRO_HINT, gyro_spectrum, recording_speed, speed_modes
 
@@ -42,7 +45,9 @@ def realism_table(recs, *, threshold_deg_s: float = 12.0, rule: str = "auto"):
     Returns
     -------
     pandas.DataFrame
-        With ``attrs['rule']`` (``"gyroscope"`` or ``"accelerometer"``).
+        One row per statistic (its units in its label), one column per recording;
+        ``attrs['rule']`` is ``"gyroscope"`` or ``"accelerometer"``, ``attrs["units"]``
+        and ``attrs["long_name"]`` label the columns.
 
     Raises
     ------
@@ -60,7 +65,7 @@ def realism_table(recs, *, threshold_deg_s: float = 12.0, rule: str = "auto"):
         )
     cols = {}
     for name, rec in recs.items():
-        acc = read(rec, "acc", to_units="g", allow_nan=True).values
+        acc = read_behavior_input(rec, "acc", to_units="g", allow_nan=True).values
         an = np.linalg.norm(acc, axis=1)
         fs = float(rec.attrs["fs"])
         if rule == "accelerometer":
@@ -100,6 +105,10 @@ def realism_table(recs, *, threshold_deg_s: float = 12.0, rule: str = "auto"):
             ]
             col["gyro power share > 10 Hz"] = float(p[f > 10].sum() / p.sum())
         cols[name] = col
-    table = pd.DataFrame(cols)
+    table = label_columns(
+        pd.DataFrame(cols),
+        units=dict.fromkeys(cols, ""),  # mixed units: each row's are in its label
+        long_name={name: str(name) for name in cols},
+    )
     table.attrs["rule"] = rule
     return table

@@ -14,7 +14,8 @@ from scipy import ndimage, signal
 
 from .. import _validate as _v
 from .. import units as _units
-from ._common import label, need_gyr, read, read_speed
+from .._deprecate import renamed
+from ._common import label, need_gyr, read_behavior_input, read_speed
 
 __all__ = [
     "angular_speed",
@@ -34,7 +35,7 @@ NO_GYRO_HINT = (
 
 def _read_gyr(gyr, fs, units, *, need_fs=False, allow_nan=True, what="angular speed"):
     need_gyr(gyr, what, NO_GYRO_HINT)
-    return read(
+    return read_behavior_input(
         gyr,
         "gyr",
         fs=fs,
@@ -45,7 +46,7 @@ def _read_gyr(gyr, fs, units, *, need_fs=False, allow_nan=True, what="angular sp
     )
 
 
-def _offset(gyr: _v.Signal, offset, name: str = "offset") -> np.ndarray:
+def _offset(gyr: _v.Signal, offset, name: str = "gyr_offset") -> np.ndarray:
     """Gyroscope offset in the units of ``gyr``: "auto", None or 3 numbers."""
     if isinstance(offset, str):
         if offset != "auto":
@@ -104,8 +105,9 @@ def speed_modes(
     min_prominence: float = 0.05,
     min_separation: float = 0.5,
 ) -> dict[str, float]:
-    r"""Still mode, moving mode and the valley between them in an angular-speed
-    distribution.
+    r"""Find the still mode, the moving mode and the valley between them.
+
+    They are those of an angular-speed distribution.
 
     The histogram of :math:`\log_{10}` speed is smoothed with a Gaussian kernel; among
     its peaks with a prominence of at least ``min_prominence`` times the highest peak,
@@ -217,32 +219,47 @@ def valley_threshold(speed, **kwargs) -> float:
     return m["valley"]
 
 
-def recording_speed(gyr, fs=None, *, units: str | None = None, offset="auto"):
-    """Angular speed (°/s) with the gyroscope offset removed.
+@renamed(gyr="data", offset="gyr_offset")
+def recording_speed(data, fs=None, *, units: str | None = None, gyr_offset="auto"):
+    """Compute the angular speed (°/s) with the gyroscope offset removed.
 
     Parameters
     ----------
-    gyr : xarray.Dataset, xarray.DataArray or array_like (N, 3)
-        A Recording (its ``gyr``), a labelled DataArray, or a plain array with
-        ``units`` (and ``fs`` for ``offset="auto"``).
+    data : xarray.Dataset, xarray.DataArray or array_like (N, 3)
+        The gyroscope: a Recording (its ``gyr``), a labelled DataArray, or a plain
+        array with ``units`` (and ``fs`` for ``gyr_offset="auto"``). Formerly ``gyr``.
     fs : float, optional
         Sampling rate (Hz) of a plain array.
     units : str, optional
-        Units of a plain ``gyr``.
-    offset : "auto", None or array_like (3,)
+        Units of a plain ``data``.
+    gyr_offset : "auto", None or array_like (3,)
         ``"auto"``: a first-pass estimate from the quietest windows
         (:func:`tiltlab.calibration.robust_gyro_offset`; needs ``fs``); ``None``: no
-        correction; or the offset in the units of ``gyr``.
+        correction; or the offset in the units of the gyroscope. Formerly ``offset``.
 
     Returns
     -------
     numpy.ndarray or xarray.DataArray (time)
         °/s; for labelled input a DataArray with ``time``, ``fs``, ``units`` and the
         offset removed (attribute ``gyr_offset_deg_s``).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from tiltlab import behavior
+    >>> gyr = np.tile([3.0, 4.0, 0.0], (200, 1))  # deg/s
+    >>> speed = behavior.recording_speed(gyr, 100.0, units="deg/s", gyr_offset=None)
+    >>> float(speed[0])
+    5.0
+    >>> speed = behavior.recording_speed(
+    ...     gyr, 100.0, units="deg/s", gyr_offset=[3.0, 0.0, 0.0]
+    ... )
+    >>> float(speed[0])
+    4.0
     """
-    need_fs = isinstance(offset, str) and offset == "auto"
-    s = _read_gyr(gyr, fs, units, need_fs=need_fs, what="recording_speed")
-    off = _offset(s, offset)
+    need_fs = isinstance(gyr_offset, str) and gyr_offset == "auto"
+    s = _read_gyr(data, fs, units, need_fs=need_fs, what="recording_speed")
+    off = _offset(s, gyr_offset)
     factor = _units.conversion_factor(s.units, "deg/s")
     attrs = {"gyr_offset_deg_s": (off * factor).tolist()}
     return label(_speed(s, off), s, "angular_speed", "deg/s", attrs=attrs)
@@ -258,6 +275,10 @@ def gyro_spectrum(
     gyr : xarray.Dataset, xarray.DataArray or array_like (N, 3)
         A Recording (its ``gyr``), a labelled DataArray, or a plain array with ``fs``
         and ``units``.
+    fs : float, optional
+        Sampling rate (Hz) of a plain array.
+    units : str, optional
+        Units of a plain ``gyr`` ('deg/s' or 'rad/s').
     nperseg_s : float
         Welch segment length (s), at most the record.
 
@@ -270,7 +291,9 @@ def gyro_spectrum(
     """
     nperseg_s = _v.positive(nperseg_s, "nperseg_s")
     need_gyr(gyr, "gyro_spectrum", NO_GYRO_HINT)
-    s = read(gyr, "gyr", fs=fs, units=units, to_units="deg/s", need_fs=True)
+    s = read_behavior_input(
+        gyr, "gyr", fs=fs, units=units, to_units="deg/s", need_fs=True
+    )
     g = s.values
     nper = max(min(g.shape[0], int(round(nperseg_s * s.fs))), 1)
     f, p = signal.welch(g - g.mean(axis=0), fs=s.fs, nperseg=nper, axis=0)

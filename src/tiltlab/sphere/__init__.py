@@ -6,8 +6,10 @@ Submodules
   exact facet areas, vectorised point location, tilt maps and visited fractions
   (Fayat et al. 2021, §2.7);
 * :mod:`~tiltlab.sphere.vmf` — von Mises–Fisher maximum likelihood (weighted, exact κ),
-  bootstrap confidence cones, the mean tilt point of a map and its angle to the sagittal
-  plane (Fayat et al. §2.8, §3.3), rotation of a baseline to the pole (Fig. 3e);
+  density, sampling and bootstrap confidence cones;
+* :mod:`~tiltlab.sphere.tiltpoint` — the mean tilt point of a map and its angle to the
+  sagittal plane (Fayat et al. §2.8, §3.3), rotation of a baseline to the pole
+  (Fig. 3e);
 * :mod:`~tiltlab.sphere.kde` — equal-area grids, location- and movement-based vMF kernel
   density estimation (mass-conserving on the grid by default: it integrates to 1 for
   any bandwidth, even at the grid's poles), reference bandwidth, cumulative isopleths,
@@ -50,10 +52,6 @@ from .vmf import (
     a3,
     a3_inverse,
     angle,
-    mean_tilt_point,
-    rotate_to_pole,
-    rotation_to_pole,
-    sagittal_angle,
     vmf_bootstrap,
     vmf_cap_area,
     vmf_fit,
@@ -72,7 +70,14 @@ from .kde import (
     mkde,
     reference_bandwidth,
     slerp,
+    slerp_vectors,
     stationarity_thirds,
+)
+from .tiltpoint import (
+    mean_tilt_point,
+    rotate_to_pole,
+    rotation_to_pole,
+    sagittal_angle,
 )
 from .residence import Residence, passage_times, residence, residence_series
 from .text import format_direction
@@ -117,6 +122,7 @@ __all__ = [
     "mkde",
     "reference_bandwidth",
     "slerp",
+    "slerp_vectors",
     "stationarity_thirds",
     "Residence",
     "passage_times",

@@ -1,8 +1,9 @@
-"""Equal-area grids on the sphere and the numba scatter of vMF kernels onto them.
+"""Build equal-area grids on the sphere and scatter vMF kernels onto them.
 
 The grid (:class:`EqualAreaGrid`, :func:`equal_area_grid`, :func:`grid_for`), the
 result type :class:`SphericalKDE`, the checks of their arguments, and the kernel sum
-with its two quadratures (:func:`_scatter`, numba :func:`_kde_scatter`), used by
+with its two quadratures (:func:`_scatter`; its numba loops are in
+:mod:`tiltlab.sphere._kde_kernel`), used by
 :func:`~tiltlab.sphere.kde` and :func:`~tiltlab.sphere.mkde`. The grid, kernels and
 quadratures are described in :mod:`tiltlab.sphere.kde`, which re-exports the public
 names.
@@ -15,10 +16,11 @@ from typing import NamedTuple
 
 import numba
 import numpy as np
-from numba import njit, prange
 
 from .. import _validate
+from ._kde_kernel import _kde_scatter
 from .mesh import as_unit_vectors, to_lonlat
+from .vmf import _check_weights
 from .vmf import _direction, _frame
 
 __all__ = [
@@ -67,23 +69,28 @@ class EqualAreaGrid:
 
     @property
     def shape(self) -> tuple[int, int]:
+        """Shape (n_lat, n_lon) of a density on the grid."""
         return (self.n_lat, self.n_lon)
 
     @property
     def lon_edges(self) -> np.ndarray:
+        """Longitudes (rad) of the cell edges, (n_lon + 1,)."""
         return np.linspace(-np.pi, np.pi, self.n_lon + 1)
 
     @property
     def s_edges(self) -> np.ndarray:
+        """Sines of the latitudes of the cell edges, (n_lat + 1,)."""
         return np.linspace(-1.0, 1.0, self.n_lat + 1)
 
     @property
     def lon_centres(self) -> np.ndarray:
+        """Longitudes (rad) of the cell centres, (n_lon,)."""
         e = self.lon_edges
         return 0.5 * (e[1:] + e[:-1])
 
     @property
     def s_centres(self) -> np.ndarray:
+        """Sines of the latitudes of the cell centres, (n_lat,)."""
         e = self.s_edges
         return 0.5 * (e[1:] + e[:-1])
 
@@ -102,18 +109,32 @@ class EqualAreaGrid:
         return self._vectors(self.lon_edges, self.s_edges)
 
     def to_grid_frame(self, vectors) -> np.ndarray:
-        """Data-frame vectors → grid-frame vectors."""
+        """Express data-frame vectors in the grid frame."""
         return np.asarray(vectors, float) @ self.rotation
 
 
 def equal_area_grid(
     cell_deg: float = 1.0, *, pole=(0.0, 0.0, 1.0), meridian=None
 ) -> EqualAreaGrid:
-    r"""Equal-area grid with :math:`\Delta\xi=\Delta s\approx` ``cell_deg`` (rad), pole along ``pole``.
+    r"""Build an equal-area grid with :math:`\Delta\xi=\Delta s\approx` ``cell_deg``.
 
-    ``n_lon = round(360/cell_deg)`` and ``n_lat = round(2/Δξ)``; a 1° grid has
-    360 × 115 = 41 400 cells of 3.04·10⁻⁴ sr. ``meridian`` (orthogonalised against
-    ``pole``) sets grid longitude 0; default: the coordinate axis least aligned with the pole.
+    ``n_lon = round(360/cell_deg)`` and ``n_lat = round(2/Δξ)`` (Δξ in rad); a 1° grid
+    has 360 × 115 = 41 400 cells of 3.04·10⁻⁴ sr.
+
+    Parameters
+    ----------
+    cell_deg : float
+        Cell size (°), in (0, 90].
+    pole : array_like (3,)
+        Direction of the grid's pole.
+    meridian : array_like (3,), optional
+        Direction of grid longitude 0 (orthogonalised against ``pole``); default: the
+        coordinate axis least aligned with the pole.
+
+    Returns
+    -------
+    EqualAreaGrid
+        The grid.
     """
     cell_deg = _check_cell_deg(cell_deg)
     n_lon = int(round(360.0 / cell_deg))
@@ -147,34 +168,30 @@ def _check_cell_deg(cell_deg) -> float:
     return cell_deg
 
 
-def _weights(weights, n: int, ok=None) -> np.ndarray:
-    """Weights (N,) finite and >= 0 on the rows kept (``ok``), else an error naming ``weights``."""
-    try:
-        w = np.asarray(weights, float)
-    except (TypeError, ValueError):
-        raise ValueError(f"weights must be numeric, got {weights!r}") from None
-    if w.shape != (n,):
-        raise ValueError(f"weights must have shape ({n},), got {w.shape}")
-    ww = w if ok is None else w[ok]
-    bad = ~np.isfinite(ww) | (ww < 0)
-    if np.any(bad):
-        raise ValueError(
-            f"weights must be finite and >= 0, got {int(bad.sum())} bad values "
-            f"(first: {ww[np.argmax(bad)]!r})"
-        )
-    return w
-
-
 def grid_for(vectors, cell_deg: float = 1.0, weights=None) -> EqualAreaGrid:
-    """Equal-area grid whose pole is 90° from the data's mean direction (data on the grid's equator).
+    """Build an equal-area grid whose pole is 90° from the data's mean direction.
 
-    ``vectors``: a labelled (time, axis) series, a Recording (its ``gravity``) or an
-    (N, 3) array; NaN rows are ignored.
+    The data then lie on the grid's equator, where its cells are square.
+
+    Parameters
+    ----------
+    vectors : xarray.DataArray, xarray.Dataset or array_like, shape (N, 3)
+        A labelled (time, axis) series, a Recording (its ``gravity``) or an (N, 3)
+        array; NaN rows are ignored.
+    cell_deg : float
+        Cell size (°), in (0, 90].
+    weights : array_like (N,), optional
+        Weights of the samples in their mean direction.
+
+    Returns
+    -------
+    EqualAreaGrid
+        The grid (the default pole when the data have no mean direction).
     """
     cell_deg = _check_cell_deg(cell_deg)
     x = as_unit_vectors(vectors, "vectors", allow_nan=True)
     ok = np.isfinite(x).all(axis=1)
-    w = None if weights is None else _weights(weights, x.shape[0], ok)
+    w = None if weights is None else _check_weights(weights, x.shape[0], ok=ok)
     m = x[ok].sum(axis=0) if w is None else w[ok] @ x[ok]
     if np.linalg.norm(m) < 1e-12:
         return equal_area_grid(cell_deg)
@@ -205,189 +222,32 @@ def _check_grid(grid) -> EqualAreaGrid:
     return grid
 
 
-# ---------------------------------------------------------------------------
-# numba scatter kernel
-# ---------------------------------------------------------------------------
-
-
-@njit(cache=True, parallel=True)
-def _kde_scatter(lon, s, kap, w, n_lon, n_lat, log_tol, exact, mass, out, scratch):
-    """Add every kernel to ``out`` (one (n_lat, n_lon) accumulator per chunk).
-
-    ``mass=False``: kernel values at the cell centres (point evaluation, truncated at
-    ``log_tol`` below the peak). ``mass=True``: the same values, relative to the
-    largest one on the grid and truncated at ``log_tol`` below it, divided by their sum
-    so that every kernel puts exactly its mass (times the cell area) on the grid;
-    ``scratch`` (one row of n_lat·n_lon per chunk) holds them between the passes.
-    """
-    nchunk = out.shape[0]
-    npts = lon.shape[0]
-    dlon = 2.0 * np.pi / n_lon
-    ds = 2.0 / n_lat
-    area = dlon * ds
-    clon = np.empty(n_lon)
-    slon = np.empty(n_lon)
-    for j in range(n_lon):
-        a = -np.pi + (j + 0.5) * dlon
-        clon[j] = np.cos(a)
-        slon[j] = np.sin(a)
-    sc = np.empty(n_lat)
-    cc = np.empty(n_lat)
-    for r in range(n_lat):
-        sc[r] = -1.0 + (r + 0.5) * ds
-        cc[r] = np.sqrt(1.0 - sc[r] * sc[r])
-    for ch in prange(nchunk):
-        acc = out[ch]
-        buf = scratch[ch]
-        jlo = np.empty(n_lat, np.int64)
-        jhi = np.empty(n_lat, np.int64)
-        for i in range(ch * npts // nchunk, (ch + 1) * npts // nchunk):
-            k = kap[i]
-            wi = w[i]
-            if wi == 0.0:
-                continue
-            si = s[i]
-            ci = np.sqrt(max(1.0 - si * si, 0.0))
-            cl = np.cos(lon[i])
-            sl = np.sin(lon[i])
-            if mass:
-                # nearest approach bound: the centre of the cell holding the kernel's centre
-                r_own = min(max(int((si + 1.0) / ds), 0), n_lat - 1)
-                j_own = min(max(int((lon[i] + np.pi) / dlon), 0), n_lon - 1)
-                c_own = si * sc[r_own] + ci * cc[r_own] * (
-                    clon[j_own] * cl + slon[j_own] * sl
-                )
-                cos_cut = min(c_own, 1.0) - 1e-12
-            else:
-                r_own = -1
-                cos_cut = 1.0
-            if k > 0.0:
-                cos_cut += log_tol / k
-            else:  # flat kernel (h so large that 1/h² underflows)
-                cos_cut = -2.0
-            if cos_cut <= -1.0:
-                theta = np.pi
-                cos_cut = -1.0
-            else:
-                theta = np.arccos(min(cos_cut, 1.0))
-            psi = np.arcsin(si)
-            lo = psi - theta
-            hi = psi + theta
-            s_lo = -1.0 if lo <= -0.5 * np.pi else np.sin(lo)
-            s_hi = 1.0 if hi >= 0.5 * np.pi else np.sin(hi)
-            r0 = max(int((s_lo + 1.0) / ds), 0)
-            r1 = min(int((s_hi + 1.0) / ds), n_lat - 1)
-            if mass:
-                r0 = min(r0, r_own)
-                r1 = max(r1, r_own)
-            # columns of the cells of each row inside the truncation cap
-            for r in range(r0, r1 + 1):
-                sr = sc[r]
-                cr = cc[r]
-                den = ci * cr
-                full = False
-                empty = False
-                cd = 0.0
-                if den < 1e-300:
-                    if si * sr >= cos_cut:
-                        full = True
-                    else:
-                        empty = True
-                else:
-                    cd = (cos_cut - si * sr) / den
-                    if cd <= -1.0:
-                        full = True
-                    elif cd > 1.0:
-                        empty = True
-                if empty:
-                    jlo[r] = 0
-                    jhi[r] = -1
-                elif full:
-                    jlo[r] = 0
-                    jhi[r] = n_lon - 1
-                else:
-                    half = np.arccos(cd)
-                    j0 = int(np.floor((lon[i] - half + np.pi) / dlon - 0.5))
-                    j1 = int(np.ceil((lon[i] + half + np.pi) / dlon - 0.5))
-                    if j1 - j0 + 1 >= n_lon:
-                        j0 = 0
-                        j1 = n_lon - 1
-                    jlo[r] = j0
-                    jhi[r] = j1
-            if not mass:
-                if exact:
-                    if k < 1e-8:  # k / (1 - e^{-2k}) -> 1/2 + k/2
-                        norm = wi * (0.5 + 0.5 * k) / np.pi
-                    else:
-                        norm = wi * k / (2.0 * np.pi * (-np.expm1(-2.0 * k)))
-                else:
-                    norm = wi * k / (2.0 * np.pi)
-                for r in range(r0, r1 + 1):
-                    sr = sc[r]
-                    cr = cc[r]
-                    for j in range(jlo[r], jhi[r] + 1):
-                        jj = j % n_lon
-                        if jj < 0:
-                            jj += n_lon
-                        cosd = si * sr + ci * cr * (clon[jj] * cl + slon[jj] * sl)
-                        acc[r, jj] += norm * np.exp(k * (cosd - 1.0))
-                continue
-            # mass-conserving: pass 1, cos(distance) of every candidate cell and the largest
-            q = 0
-            cmax = -2.0
-            for r in range(r0, r1 + 1):
-                sr = sc[r]
-                cr = cc[r]
-                for j in range(jlo[r], jhi[r] + 1):
-                    jj = j % n_lon
-                    if jj < 0:
-                        jj += n_lon
-                    cosd = si * sr + ci * cr * (clon[jj] * cl + slon[jj] * sl)
-                    buf[q] = cosd
-                    q += 1
-                    if cosd > cmax:
-                        cmax = cosd
-            if q == 0:  # pragma: no cover - the own cell is always a candidate
-                continue
-            # pass 2: values relative to the largest, truncated at log_tol below it
-            tot = 0.0
-            for p in range(q):
-                d = buf[p] - cmax
-                if d >= 0.0:
-                    e = 1.0
-                else:
-                    x = k * d
-                    e = np.exp(x) if x >= log_tol else 0.0
-                buf[p] = e
-                tot += e
-            # the kernel's exact mass: 1 (vMF) or 1 - e^{-2k} (Gaussian-on-chord, Eq. 15)
-            m = wi if exact else wi * (-np.expm1(-2.0 * k))
-            f = m / (tot * area)
-            # pass 3: deposit in the same order
-            q = 0
-            for r in range(r0, r1 + 1):
-                for j in range(jlo[r], jhi[r] + 1):
-                    jj = j % n_lon
-                    if jj < 0:
-                        jj += n_lon
-                    acc[r, jj] += f * buf[q]
-                    q += 1
-
-
 _MAX_CELLS = (
     20_000_000  # grid cells (a 0.045° grid); each accumulator is 8 bytes a cell
 )
 
 
-def _scatter(
-    x, w, h, grid: EqualAreaGrid, kernel: str, tol: float, quadrature: str
-) -> np.ndarray:
-    if kernel not in ("vmf", "gauss"):
-        raise ValueError(f"kernel must be 'vmf' or 'gauss', got {kernel!r}")
-    if quadrature not in ("mass", "point"):
-        raise ValueError(f"quadrature must be 'mass' or 'point', got {quadrature!r}")
-    _validate.fraction(tol, "tol", open_low=True, open_high=True)
-    h = np.broadcast_to(np.asarray(h, float), (x.shape[0],))
+class _KDESettings(NamedTuple):
+    """Grid and kernel settings shared by :func:`~tiltlab.sphere.kde` and ``mkde``."""
+
+    grid: EqualAreaGrid | None = None
+    kernel: str = "vmf"
+    cell_deg: float = 1.0
+    tol: float = 1e-10
+    quadrature: str = "mass"
+
+
+def _settings(options: dict, caller: str) -> _KDESettings:
+    """Return the settings record of keyword ``options`` (a ``TypeError`` for others)."""
+    unknown = sorted(set(options) - set(_KDESettings._fields))
+    if unknown:
+        raise TypeError(f"{caller}() got an unexpected keyword argument {unknown[0]!r}")
+    return _KDESettings(**options)
+
+
+def _kappas(h, n: int, quadrature: str) -> np.ndarray:
+    """Return the concentrations 1/h² of n kernels, checking the bandwidths ``h``."""
+    h = np.broadcast_to(np.asarray(h, float), (n,))
     bad = ~np.isfinite(h) | (h <= 0)
     if np.any(bad):
         raise ValueError(
@@ -400,6 +260,18 @@ def _scatter(
             f"bandwidth h = {h[np.argmax(~np.isfinite(kap))]!r} is too small to "
             "evaluate (1/h² overflows); use quadrature='mass'"
         )
+    return kap
+
+
+def _scatter(x, w, h, grid: EqualAreaGrid, settings: _KDESettings) -> np.ndarray:
+    """Return the weighted kernel sum of ``x`` (N, 3) on ``grid`` (see ``kde``)."""
+    kernel, tol, quadrature = settings.kernel, settings.tol, settings.quadrature
+    if kernel not in ("vmf", "gauss"):
+        raise ValueError(f"kernel must be 'vmf' or 'gauss', got {kernel!r}")
+    if quadrature not in ("mass", "point"):
+        raise ValueError(f"quadrature must be 'mass' or 'point', got {quadrature!r}")
+    _validate.fraction(tol, "tol", open_low=True, open_high=True)
+    kap = _kappas(h, x.shape[0], quadrature)
     g = grid.to_grid_frame(x)
     lon, lat = to_lonlat(g)
     s = np.clip(g[:, 2], -1.0, 1.0)
@@ -425,3 +297,10 @@ def _scatter(
         scratch,
     )
     return out.sum(axis=0) / w.sum()
+
+
+def _settings_grid(settings: _KDESettings, vectors, weights=None) -> EqualAreaGrid:
+    """Return ``settings.grid`` (checked), else :func:`grid_for` the data."""
+    if settings.grid is None:
+        return grid_for(vectors, settings.cell_deg, weights)
+    return _check_grid(settings.grid)

@@ -12,7 +12,8 @@ import numpy as np
 import pandas as pd
 
 from .. import _validate
-from ._kde_grid import SphericalKDE, _weights
+from ._kde_grid import SphericalKDE
+from .vmf import _check_weights
 from .mesh import as_unit_vectors, to_lonlat
 from .vmf import angle, vmf_fit
 
@@ -54,7 +55,7 @@ def _dens_area(density, cell_area):
 
 
 def isopleths(density, cell_area=None, levels=(0.5, 0.95)) -> pd.DataFrame:
-    r"""Smallest areas holding given fractions of the distribution (cumulative isopleths).
+    r"""Find the smallest areas holding given fractions of the distribution (isopleths).
 
     Cells are sorted by decreasing density and their probability masses
     :math:`a_cU_c` summed (jointly, so cells of unequal area are handled) until the level
@@ -67,12 +68,14 @@ def isopleths(density, cell_area=None, levels=(0.5, 0.95)) -> pd.DataFrame:
         A KDE or densities per cell (e.g. a tilt map's ``density`` per facet).
     cell_area : float or array
         Cell areas (sr) when ``density`` is an array.
-    levels : sequence of float in (0, 1)
+    levels : sequence of float
+        Probability masses of the isopleths, each in (0, 1).
 
     Returns
     -------
-    pandas.DataFrame indexed by level: ``threshold`` (density at the isopleth), ``area``
-    (sr) and ``sphere_fraction`` (area / 4π).
+    pandas.DataFrame
+        Indexed by level: ``threshold`` (density at the isopleth), ``area`` (sr) and
+        ``sphere_fraction`` (area / 4π).
     """
     if not isinstance(density, SphericalKDE) and cell_area is None:
         raise ValueError("cell_area is required when density is an array")
@@ -99,7 +102,22 @@ def isopleths(density, cell_area=None, levels=(0.5, 0.95)) -> pd.DataFrame:
 
 
 def isopleth_mask(density, level: float, cell_area=None) -> np.ndarray:
-    """Boolean mask (shape of the density) of the cells inside the ``level`` cumulative isopleth."""
+    """Mark the cells inside the ``level`` cumulative isopleth.
+
+    Parameters
+    ----------
+    density : SphericalKDE or array_like
+        A KDE, or densities (sr⁻¹) on equal-area cells.
+    level : float
+        Probability mass of the isopleth, in (0, 1).
+    cell_area : float, optional
+        Cell area (sr) of a plain ``density`` (see :func:`isopleths`).
+
+    Returns
+    -------
+    numpy.ndarray of bool
+        True for the cells inside, with the shape of the density.
+    """
     level = _validate.fraction(level, "level", open_low=True, open_high=True)
     arr = (
         density.density
@@ -116,7 +134,9 @@ def isopleth_mask(density, level: float, cell_area=None) -> np.ndarray:
 
 
 def stationarity_thirds(vectors, weights=None) -> pd.DataFrame:
-    r"""Mean direction and dispersion in the first, second and third thirds of a series (Benhamou §7).
+    r"""Compare the mean direction and dispersion of the three thirds of a series.
+
+    Benhamou §7.
 
     A distribution is meaningful only for a stationary process; Benhamou advises checking
     that mean and variance stay similar across the three thirds. Each row gives the vMF
@@ -126,14 +146,24 @@ def stationarity_thirds(vectors, weights=None) -> pd.DataFrame:
     mean and the overall mean (degrees). ``df.attrs`` holds the largest of those angles
     (``max_angle_deg``) and the largest/smallest κ̂ ratio (``kappa_ratio``).
 
-    ``vectors``: a labelled (time, axis) series, a Recording (its ``gravity``) or an
-    (N, 3) array, in time order.
+    Parameters
+    ----------
+    vectors : xarray.DataArray, xarray.Dataset or array_like, shape (N, 3)
+        A labelled (time, axis) series, a Recording (its ``gravity``) or an (N, 3)
+        array, in time order (at least 3 samples).
+    weights : array_like (N,), optional
+        Weights of the samples (finite, >= 0).
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per third (``first``, ``second``, ``third``) and one for ``all``.
     """
     x = as_unit_vectors(vectors, "vectors")
     n = x.shape[0]
     if n < 3:
         raise ValueError(f"vectors needs at least 3 samples, got {n}")
-    w = np.ones(n) if weights is None else _weights(weights, n)
+    w = np.ones(n) if weights is None else _check_weights(weights, n)
     edges = np.linspace(0, n, 4).round().astype(int)
     parts = [
         ("first", slice(edges[0], edges[1])),

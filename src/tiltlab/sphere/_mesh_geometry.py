@@ -1,5 +1,6 @@
-r"""Spherical geometry without a mesh: longitude/latitude conversions and exact
-spherical-triangle areas (private part of :mod:`tiltlab.sphere.mesh`).
+r"""Convert longitude/latitude and compute exact spherical-triangle areas, without a mesh.
+
+The private part of :mod:`tiltlab.sphere.mesh`.
 
 Everything here is re-exported by :mod:`tiltlab.sphere.mesh` (and :mod:`tiltlab.sphere`),
 where it is documented and imported from; this module imports nothing from it (the
@@ -51,7 +52,9 @@ def to_lonlat(v) -> tuple[np.ndarray, np.ndarray]:
 
 
 def from_lonlat(lon, lat) -> np.ndarray:
-    """Unit vectors from longitude and latitude (rad), shape (..., 3); inverse of :func:`to_lonlat`.
+    """Return unit vectors from longitude and latitude (rad), shape (..., 3).
+
+    The inverse of :func:`to_lonlat`.
 
     Parameters
     ----------

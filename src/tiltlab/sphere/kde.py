@@ -1,6 +1,7 @@
-r"""Spherical kernel density estimation (Benhamou 2023, §7, Eqs. 14–16): equal-area grids,
-von Mises–Fisher kernels, reference bandwidth, cumulative isopleths, location- and
-movement-based KDE, and a stationarity check.
+r"""Estimate spherical kernel densities (Benhamou 2023, §7, Eqs. 14–16).
+
+Equal-area grids, von Mises–Fisher kernels, reference bandwidth, cumulative isopleths,
+location- and movement-based KDE, and a stationarity check.
 
 Kernels
 -------
@@ -53,9 +54,10 @@ quadrature (see *Quadrature*); the grid can therefore be rotated (``pole``), and
 
 Layout
 ------
-This module holds the bandwidth rule, :func:`kde`, :func:`slerp` and :func:`mkde`; the
-grid, the result type and the numba kernel sum are in
-:mod:`tiltlab.sphere._kde_grid`, the isopleths and the stationarity check in
+This module holds the bandwidth rule, :func:`kde`, :func:`slerp_vectors` and
+:func:`mkde`; the grid, the result type and the kernel sum are in
+:mod:`tiltlab.sphere._kde_grid` (its numba loops in :mod:`tiltlab.sphere._kde_kernel`),
+the isopleths and the stationarity check in
 :mod:`tiltlab.sphere._kde_summaries`. Every public name is importable from here.
 
 References
@@ -76,19 +78,21 @@ import warnings
 import numpy as np
 
 from .. import _validate
+from .._deprecate import alias
 from ._kde_grid import (
     EqualAreaGrid,
     SphericalKDE,
     _check_cell_deg,
-    _check_grid,
+    _KDESettings,
     _scatter,
-    _weights,
+    _settings,
+    _settings_grid,
     equal_area_grid,
     grid_for,
 )
 from ._kde_summaries import isopleth_mask, isopleths, stationarity_thirds
 from .mesh import _series, as_unit_vectors
-from .vmf import angle, vmf_fit
+from .vmf import _check_weights, angle, vmf_fit
 
 __all__ = [
     "EqualAreaGrid",
@@ -101,6 +105,7 @@ __all__ = [
     "isopleths",
     "isopleth_mask",
     "stationarity_thirds",
+    "slerp_vectors",
     "slerp",
 ]
 
@@ -112,7 +117,9 @@ __all__ = [
 def reference_bandwidth(
     vectors, weights=None, *, n: int | None = None, method: str = "mle"
 ) -> float:
-    r"""Reference smoothing parameter :math:`h_{ref}=\hat\kappa^{-1/2}\,n^{-1/6}` (Benhamou §7; Silverman's rule).
+    r"""Compute the reference bandwidth :math:`h_{ref}=\hat\kappa^{-1/2}\,n^{-1/6}`.
+
+    Benhamou §7; Silverman's rule.
 
     Parameters
     ----------
@@ -126,6 +133,11 @@ def reference_bandwidth(
         κ̂ from :math:`A_3^{-1}(\bar R)` (MLE), or :math:`1/\hat\kappa = 1-\bar R`
         (Benhamou's printed form; the two agree to :math:`O(e^{-2\kappa})` once κ ≳ 3,
         because :math:`A_3(\kappa) = \coth\kappa - 1/\kappa \approx 1-1/\kappa`).
+
+    Returns
+    -------
+    float
+        The bandwidth h (rad).
 
     Raises
     ------
@@ -178,7 +190,9 @@ def kde(
     tol: float = 1e-10,
     quadrature: str = "mass",
 ) -> SphericalKDE:
-    r"""Location-based spherical KDE (Benhamou Eq. 15 with vMF kernels) on an equal-area grid.
+    r"""Estimate a location-based spherical KDE on an equal-area grid.
+
+    Benhamou's Eq. 15 with vMF kernels:
 
     .. math:: U_c = \frac{\sum_i w_i K_h(c;\mu_i)}{\sum_i w_i}
 
@@ -192,8 +206,11 @@ def kde(
     h : float, optional
         Bandwidth (rad); default :func:`reference_bandwidth`.
     weights : array_like (N,), optional
+        Weights of the samples (finite, >= 0, not all zero).
     kernel : {"vmf", "gauss"}
         Exact vMF (Eq. 14a) or Benhamou's Gaussian-on-chord form (Eq. 15).
+    cell_deg : float
+        Cell size (°) of the default grid.
     tol : float
         Kernel truncation (relative to its peak), in (0, 1).
     quadrature : {"mass", "point"}
@@ -204,6 +221,7 @@ def kde(
     Returns
     -------
     SphericalKDE
+        The density (sr⁻¹) on the grid, the grid and the bandwidth.
 
     Raises
     ------
@@ -211,13 +229,26 @@ def kde(
         For zero vectors, bad ``weights`` (negative, non-finite, wrong shape, all zero),
         a non-positive or non-finite ``h``, and when the default bandwidth rule fails
         (all samples identical: :func:`reference_bandwidth`).
+
+    Examples
+    --------
+    >>> from tiltlab import sphere
+    >>> x = sphere.vmf_sample([0.0, 0.0, 1.0], 20.0, 500, rng=0)
+    >>> est = sphere.kde(x, h=0.2, cell_deg=5.0)
+    >>> est.density.shape, round(est.integral(), 6)
+    ((23, 72), 1.0)
     """
+    settings = _KDESettings(grid, kernel, cell_deg, tol, quadrature)
     x = as_unit_vectors(vectors, "vectors", allow_nan=True)
     ok = np.isfinite(x).all(axis=1)
     if h is not None:
         h = _validate.positive(h, "h")
-    cell_deg = _check_cell_deg(cell_deg)
-    w = np.ones(x.shape[0]) if weights is None else _weights(weights, x.shape[0], ok)
+    _check_cell_deg(cell_deg)
+    w = (
+        np.ones(x.shape[0])
+        if weights is None
+        else _check_weights(weights, x.shape[0], ok=ok)
+    )
     x, w = x[ok], w[ok]
     if x.shape[0] == 0:
         raise ValueError("vectors has no finite rows (no data)")
@@ -227,14 +258,12 @@ def kde(
         raise ValueError(f"weights sum to {w.sum()!r} (overflow); rescale them")
     if h is None:
         h = reference_bandwidth(x, w if weights is not None else None)
-    grid = grid_for(x, cell_deg, w) if grid is None else _check_grid(grid)
-    return SphericalKDE(
-        _scatter(x, w, h, grid, kernel, tol, quadrature), grid, float(h)
-    )
+    grid = _settings_grid(settings, x, w)
+    return SphericalKDE(_scatter(x, w, h, grid, settings), grid, float(h))
 
 
 def _rows(v, name: str) -> np.ndarray:
-    """Directions (..., 3) normalised; zero or non-finite rows are an error naming ``name``."""
+    """Return directions (..., 3) normalised; zero or non-finite rows are an error."""
     a = _validate.vectors(v, name, width=3, ndim=None)
     n = np.linalg.norm(a, axis=-1, keepdims=True)
     if np.any(n == 0):
@@ -244,8 +273,12 @@ def _rows(v, name: str) -> np.ndarray:
     return a / n
 
 
-def slerp(a, b, t) -> np.ndarray:
-    r"""Points at fraction t along the orthodromic arcs a→b (rows), :math:`\frac{\sin((1-t)\omega)a+\sin(t\omega)b}{\sin\omega}`.
+def slerp_vectors(a, b, t) -> np.ndarray:
+    r"""Interpolate unit vectors along the great-circle arcs from ``a`` to ``b``.
+
+    The point at fraction t of the orthodromic arc a→b (rows) is
+    :math:`\frac{\sin((1-t)\omega)a+\sin(t\omega)b}{\sin\omega}`, ω the angle between
+    them. (For rotations, see :func:`tiltlab.quaternion.slerp`.)
 
     Parameters
     ----------
@@ -266,6 +299,16 @@ def slerp(a, b, t) -> np.ndarray:
         some row: every great circle through them is a shortest arc, so the path is
         undefined (no direction is chosen arbitrarily; before, the point jumped from
         ``a`` to ``b`` through NaN at t = 1/2). The message names the first row.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from tiltlab import sphere
+    >>> p = sphere.slerp_vectors([1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, 0.5, 1.0])
+    >>> np.round(p, 3)
+    array([[1.   , 0.   , 0.   ],
+           [0.707, 0.   , 0.707],
+           [0.   , 0.   , 1.   ]])
     """
     a, b = _rows(a, "a"), _rows(b, "b")
     t = _validate.vectors(t, "t", width=None, ndim=None)[..., None]
@@ -295,25 +338,26 @@ def mkde(
     *,
     fs: float | None = None,
     times=None,
-    grid: EqualAreaGrid | None = None,
     h: float | None = None,
     step: float | None = None,
     diffusion: float = 0.0,
     max_gap: float = np.inf,
-    kernel: str = "vmf",
-    cell_deg: float = 1.0,
-    tol: float = 1e-10,
-    quadrature: str = "mass",
+    **settings,
 ) -> SphericalKDE:
-    r"""Movement-based spherical KDE: kernels placed along the orthodromic arcs between successive samples.
+    r"""Estimate a movement-based spherical KDE from kernels along the path.
 
-    Each step :math:`x_k\to x_{k+1}` (duration :math:`\Delta t_k`, arc :math:`\omega_k`) is
-    cut into :math:`m_k=\lceil\omega_k/\mathrm{step}\rceil` equal sub-arcs; a kernel sits at
-    the middle of each (:func:`slerp` at :math:`\alpha=(j+\tfrac12)/m_k`) with weight
-    :math:`\Delta t_k/m_k`, so the density is the fraction of *time* spent near each
-    direction. With ``diffusion`` :math:`D` > 0 (rad²/s) the bandwidth grows inside the
-    step like a Brownian bridge, :math:`h^2(\alpha) = h^2 + \alpha(1-\alpha)D\Delta t_k`
-    — a simplified, unbiased version of Benhamou's biased random bridges [3]_.
+    The kernels are placed along the orthodromic arcs between successive samples. Each
+    step :math:`x_k\to x_{k+1}` (duration :math:`\Delta t_k`, arc :math:`\omega_k`) is
+    cut into :math:`m_k=\lceil\omega_k/\mathrm{step}\rceil` equal sub-arcs; a kernel sits
+    at the middle of each (:func:`slerp_vectors` at :math:`\alpha=(j+\tfrac12)/m_k`) with
+    weight :math:`\Delta t_k/m_k`, so the density is the fraction of *time* spent near
+    each direction. With ``diffusion`` :math:`D` > 0 (rad²/s) the bandwidth grows inside
+    the step like a Brownian bridge, :math:`h^2(\alpha) = h^2 + \alpha(1-\alpha)D\Delta
+    t_k` — a simplified, unbiased version of Benhamou's biased random bridges [3]_.
+
+    At most 5·10⁷ kernels are placed (beyond that, an error names ``step``). Two
+    successive samples in opposite directions are an error naming them (the arc
+    between antipodal points is not unique, see :func:`slerp_vectors`).
 
     Parameters
     ----------
@@ -321,28 +365,58 @@ def mkde(
         Time-ordered directions: a labelled (time, axis) series with ``attrs["fs"]`` (e.g.
         :func:`tiltlab.filters.gravity`), a Recording with a ``gravity`` variable, or a
         plain array.
-    fs, times : sampling rate (Hz) or sample times (s) of a plain array (one is
-        required). Labelled data use their ``time`` coordinate and ``fs``; an ``fs`` that
+    fs, times : float or array_like (N,), optional
+        Sampling rate (Hz) or sample times (s) of a plain array (one is required).
+        Labelled data use their ``time`` coordinate and ``fs``; an ``fs`` that
         contradicts ``attrs["fs"]`` is an error, and so is labelled data without ``fs``.
-    h : base bandwidth (rad), default :func:`reference_bandwidth` of the samples.
-    step : maximal sub-arc length (rad), default h/2.
-    diffusion : Brownian-bridge diffusion coefficient (rad²/s), ≥ 0.
-    max_gap : steps longer than this (s) are dropped (data gaps).
-    kernel, cell_deg, tol, quadrature : as in :func:`kde`.
+    h : float, optional
+        Base bandwidth (rad), default :func:`reference_bandwidth` of the samples.
+    step : float, optional
+        Maximal sub-arc length (rad), default h/2.
+    diffusion : float
+        Brownian-bridge diffusion coefficient (rad²/s), ≥ 0.
+    max_gap : float
+        Steps longer than this (s) are dropped (data gaps).
+    **settings
+        ``grid``, ``kernel``, ``cell_deg``, ``tol`` and ``quadrature``, as in
+        :func:`kde`.
 
-    At most 5·10⁷ kernels are placed (beyond that, an error names ``step``). Two
-    successive samples in opposite directions are an error naming them (the arc
-    between antipodal points is not unique, see :func:`slerp`).
+    Returns
+    -------
+    SphericalKDE
+        The density (sr⁻¹: fraction of time per steradian), the grid and the base
+        bandwidth ``h``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from tiltlab import sphere
+    >>> t = np.linspace(0.0, 1.0, 50)
+    >>> path = np.column_stack([np.cos(t), np.sin(t), np.zeros_like(t)])
+    >>> est = sphere.mkde(path, fs=10.0, h=0.1, cell_deg=5.0)
+    >>> round(est.integral(), 6), est.h
+    (1.0, 0.1)
     """
+    opts = _settings(settings, "mkde")
     x, t, _ = _series(vectors, fs, times)
     n = x.shape[0]
     if n < 2:
         raise ValueError(f"vectors needs at least 2 samples, got {n}")
     diffusion = _validate.nonnegative(diffusion, "diffusion")
     max_gap = _validate.positive(max_gap, "max_gap", allow_inf=True)
-    cell_deg = _check_cell_deg(cell_deg)
+    _check_cell_deg(opts.cell_deg)
     h = reference_bandwidth(x) if h is None else _validate.positive(h, "h")
     step = h / 2 if step is None else _validate.positive(step, "step")
+    a, b, dt, om = _steps(x, t, max_gap)
+    pts, alpha, k, mk = _sub_arcs(a, b, om, step)
+    w = dt[k] / mk
+    hh = np.sqrt(h * h + alpha * (1 - alpha) * diffusion * dt[k])
+    grid = _settings_grid(opts, x)
+    return SphericalKDE(_scatter(pts, w, hh, grid, opts), grid, float(h))
+
+
+def _steps(x, t, max_gap: float):
+    """Return the starts, ends, durations and arcs of the steps up to ``max_gap`` long."""
     dt = np.diff(t)
     keep = dt <= max_gap
     a, b, dt = x[:-1][keep], x[1:][keep], dt[keep]
@@ -357,6 +431,14 @@ def mkde(
             "between them (a half-turn) has no defined great circle; drop the bad "
             "sample or give a max_gap that excludes that step"
         )
+    return a, b, dt, om
+
+
+def _sub_arcs(a, b, om, step: float):
+    """Return the sub-arc midpoints, their fractions α, their step and its sub-arcs.
+
+    Every step a→b (arc ``om``) is cut into m = ⌈ω/step⌉ equal sub-arcs (at least one).
+    """
     m = np.maximum(1, np.ceil(om / step))
     if m.sum() > _MAX_KERNELS:
         raise ValueError(
@@ -367,13 +449,10 @@ def mkde(
     k = np.repeat(np.arange(a.shape[0]), m)
     j = np.arange(k.size) - np.repeat(np.cumsum(m) - m, m)
     alpha = (j + 0.5) / m[k]
-    pts = slerp(a[k], b[k], alpha)
-    w = dt[k] / m[k]
-    hh = np.sqrt(h * h + alpha * (1 - alpha) * diffusion * dt[k])
-    grid = grid_for(x, cell_deg) if grid is None else _check_grid(grid)
-    return SphericalKDE(
-        _scatter(pts, w, hh, grid, kernel, tol, quadrature), grid, float(h)
-    )
+    return slerp_vectors(a[k], b[k], alpha), alpha, k, m[k]
+
+
+slerp = alias(slerp_vectors, "slerp")
 
 
 _MAX_KERNELS = 50_000_000

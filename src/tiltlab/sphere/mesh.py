@@ -1,5 +1,7 @@
-r"""Triangulated unit sphere: Fibonacci lattice, spherical Delaunay facets, exact areas,
-vectorised point location and tilt maps (Fayat et al. 2021, §2.7 and §3.3).
+r"""Triangulate the unit sphere and count directions on it (tilt maps).
+
+Fibonacci lattice, spherical Delaunay facets, exact areas, vectorised point location
+and tilt maps (Fayat et al. 2021, §2.7 and §3.3).
 
 The vertices are a spherical Fibonacci lattice; the convex hull of points on the unit
 sphere is their spherical Delaunay triangulation (each hull facet's circumscribed
@@ -187,7 +189,7 @@ def _read(
 
 
 def _series(vectors, fs, times, name: str = "vectors"):
-    """Unit vectors (N, 3), their times (s) and the Signal read from ``vectors``.
+    """Return unit vectors (N, 3), their times (s) and the Signal read from ``vectors``.
 
     Times come from ``times`` (strictly increasing, shape (N,)), else from the data's
     ``time`` coordinate, else from ``fs`` (``t = i / fs``). Without ``times`` the sampling
@@ -261,10 +263,12 @@ class SphereMesh:
 
     @property
     def n_vertices(self) -> int:
+        """Number of vertices V."""
         return self.vertices.shape[0]
 
     @property
     def n_faces(self) -> int:
+        """Number of facets F."""
         return self.faces.shape[0]
 
     def area_ratio(self) -> float:
@@ -272,6 +276,7 @@ class SphereMesh:
         return float(self.areas.max() / self.areas.min())
 
     def __repr__(self) -> str:
+        """Show the sizes and the area ratio."""
         return f"SphereMesh(n_vertices={self.n_vertices}, n_faces={self.n_faces}, area_ratio={self.area_ratio():.3f})"
 
 
@@ -341,9 +346,19 @@ def triangulate(vertices, *, lut_m: int | None = None) -> SphereMesh:
 
 @lru_cache(maxsize=8)
 def sphere_mesh(n: int = 5000) -> SphereMesh:
-    """The (cached) triangulated Fibonacci sphere with ``n`` vertices (Fayat et al. used n = 5000).
+    """Return the (cached) triangulated Fibonacci sphere with ``n`` vertices.
 
-    ``n`` is an integer in [4, 10⁷].
+    Fayat et al. used n = 5000.
+
+    Parameters
+    ----------
+    n : int
+        Number of vertices, in [4, 10⁷].
+
+    Returns
+    -------
+    SphereMesh
+        The triangulation (shared between calls: it is immutable).
     """
     n = _validate.integer(n, "n", minimum=4)
     if n > 10_000_000:
@@ -549,7 +564,7 @@ def _check_mesh(mesh) -> SphereMesh:
 
 
 def histogram(vectors, mesh: SphereMesh | None = None, *, weights=None) -> np.ndarray:
-    """Number of samples (or summed ``weights``) per facet, shape (F,).
+    """Count the samples (or sum their ``weights``) per facet, shape (F,).
 
     ``vectors`` is a labelled (time, axis) series, a Recording (its ``gravity``) or an
     (N, 3) array. Rows that are NaN (e.g. masked samples) are ignored; zero rows (no
@@ -578,7 +593,7 @@ def histogram(vectors, mesh: SphereMesh | None = None, *, weights=None) -> np.nd
 def tilt_map(
     vectors, *, mesh: SphereMesh | None = None, fs: float | None = None, mask=None
 ) -> xr.Dataset:
-    r"""Head-tilt map: counts, time, time fraction and area-normalised density per facet.
+    r"""Map head tilt: counts, time, time fraction and area-normalised density per facet.
 
     Parameters
     ----------
@@ -606,6 +621,16 @@ def tilt_map(
         ``axis_labels``. With no valid sample (everything masked out or NaN) the map
         is empty rather than an error: ``count`` 0, ``fraction`` and ``density`` NaN,
         ``attrs["empty_reason"]`` saying why, and a :class:`RuntimeWarning`.
+
+    Examples
+    --------
+    >>> from tiltlab import sphere
+    >>> g = sphere.vmf_sample([0.0, 0.0, 1.0], 50.0, 200, rng=0)
+    >>> tmap = sphere.tilt_map(g, mesh=sphere.sphere_mesh(500), fs=100.0)
+    >>> int(tmap["count"].sum()), float(tmap["time"].sum())
+    (200, 2.0)
+    >>> round(float((tmap["density"] * tmap["area"]).sum()), 6)
+    1.0
     """
     mesh = _check_mesh(mesh)
     sig = _read(vectors, fs=fs, need_fs=False, check_time=True, allow_nan=True)
@@ -723,6 +748,15 @@ def visited_fraction(
     ------
     ValueError
         If the map and the mesh have different numbers of facets, or ``by`` is invalid.
+
+    Examples
+    --------
+    >>> from tiltlab import sphere
+    >>> mesh = sphere.sphere_mesh(500)
+    >>> g = sphere.vmf_sample([0.0, 0.0, 1.0], 50.0, 200, rng=0)
+    >>> tmap = sphere.tilt_map(g, mesh=mesh)
+    >>> round(sphere.visited_fraction(tmap, mesh), 3)
+    0.04
     """
     mesh = _check_mesh(mesh)
     if isinstance(tmap, xr.Dataset) and tmap.attrs.get("n_samples", 1) == 0:

@@ -48,9 +48,11 @@ __all__ = ["Residence", "passage_times", "residence", "residence_series"]
 
 
 class Residence(NamedTuple):
-    """Per centre: ``total`` time inside the cap (s), ``n_visits``, ``mean_residence``
-    (total / n_visits, NaN when never visited) and ``residence`` (residence time of the
-    visit containing the reference time; NaN when none given or not inside then).
+    """Residence per centre: time inside, visits, mean and current residence.
+
+    ``total`` time inside the cap (s), ``n_visits``, ``mean_residence`` (total /
+    n_visits, NaN when never visited) and ``residence`` (residence time of the visit
+    containing the reference time; NaN when none given or not inside then).
     """
 
     total: np.ndarray
@@ -147,7 +149,7 @@ def residence(
     times=None,
     ref_times=None,
 ) -> Residence:
-    """Time inside, number of visits and mean residence time per visit for caps around ``centres``.
+    """Measure time inside, visits and mean residence per visit in caps around ``centres``.
 
     Parameters
     ----------
@@ -155,19 +157,25 @@ def residence(
         Time-ordered directions: a labelled (time, axis) series with ``attrs["fs"]``
         (e.g. :func:`tiltlab.filters.gravity`), a Recording with a ``gravity`` variable,
         or a plain array with ``fs`` or ``times``.
-    centres : (M, 3) cap centres (e.g. a grid's or a mesh's vertices, for maps).
-    radius : angular radius of the caps (rad), in (0, π/2).
-    t_out : excursions outside a cap no longer than this (s) do not end a visit.
-    fs, times : sampling rate (Hz) or sample times (s) of a plain array. Labelled data
-        use their ``time`` coordinate (else ``i / fs``); an ``fs`` contradicting
+    centres : array_like, shape (M, 3)
+        Cap centres (e.g. a grid's or a mesh's vertices, for maps).
+    radius : float
+        Angular radius of the caps (rad), in (0, π/2).
+    t_out : float
+        Excursions outside a cap no longer than this (s) do not end a visit.
+    fs, times : float or array_like (N,), optional
+        Sampling rate (Hz) or sample times (s) of a plain array. Labelled data use
+        their ``time`` coordinate (else ``i / fs``); an ``fs`` contradicting
         ``attrs["fs"]`` is an error.
-    ref_times : (M,), optional
+    ref_times : array_like (M,), optional
         A time per centre (on the data's clock); ``residence`` is then the residence time
         of the visit containing it (NaN where a time is NaN).
 
     Returns
     -------
     Residence
+        Per centre: ``total`` time inside (s), ``n_visits``, ``mean_residence`` (s) and
+        ``residence`` at ``ref_times``.
     """
     radius, t_out = _check(radius, t_out)
     x, t, _ = _series(vectors, fs, times)

@@ -10,7 +10,7 @@ __all__ = ["format_direction"]
 
 
 def format_direction(v, digits: int = 4) -> str:
-    """A direction as a short tuple of signed numbers.
+    """Format a direction as a short tuple of signed numbers.
 
     Parameters
     ----------

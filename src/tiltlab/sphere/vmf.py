@@ -1,5 +1,8 @@
-r"""von Mises–Fisher distribution on :math:`S^2`: weighted maximum likelihood, bootstrap
-confidence cone, mean tilt point of a map, angle to the sagittal plane, rotation to the pole.
+r"""Fit, evaluate and sample the von Mises–Fisher distribution on :math:`S^2`.
+
+Weighted maximum likelihood, density, sampling, cap areas and bootstrap confidence
+cones. The summaries of a tilt map built on them (mean tilt point, sagittal angle,
+rotation to the pole) are in :mod:`tiltlab.sphere.tiltpoint`.
 
 The density of a von Mises–Fisher (vMF) distribution with mean direction :math:`\mu` and
 concentration :math:`\kappa` on the unit sphere is (Benhamou 2023, Eq. 14a)
@@ -38,10 +41,9 @@ import warnings
 from typing import NamedTuple
 
 import numpy as np
-import xarray as xr
 
 from .. import _validate
-from .mesh import SphereMesh, _read, as_unit_vectors, sphere_mesh
+from .mesh import _read, as_unit_vectors
 
 __all__ = [
     "VMFFit",
@@ -54,17 +56,15 @@ __all__ = [
     "vmf_sample",
     "vmf_cap_area",
     "vmf_bootstrap",
-    "mean_tilt_point",
-    "sagittal_angle",
-    "rotation_to_pole",
-    "rotate_to_pole",
     "angle",
 ]
 
 
 class VMFFit(NamedTuple):
-    """Maximum-likelihood vMF fit: mean direction ``mu`` (3,), concentration ``kappa``,
-    mean resultant length ``rbar`` and total weight ``n``.
+    """Maximum-likelihood vMF fit.
+
+    Mean direction ``mu`` (3,), concentration ``kappa``, mean resultant length ``rbar``
+    and total weight ``n``.
     """
 
     mu: np.ndarray
@@ -74,8 +74,10 @@ class VMFFit(NamedTuple):
 
 
 class ConfidenceCone(NamedTuple):
-    """Bootstrap confidence cone around ``mu``: half-angle (rad) at ``level``, κ interval,
-    and the bootstrap angles between each replicate's mean and ``mu``.
+    """Bootstrap confidence cone around ``mu``.
+
+    Half-angle (rad) at ``level``, κ interval, and the bootstrap angles between each
+    replicate's mean and ``mu``.
     """
 
     mu: np.ndarray
@@ -245,21 +247,32 @@ def a3_inverse(rbar, *, tol: float = 1e-13, max_iter: int = 100) -> np.ndarray:
 # ---------------------------------------------------------------------------
 
 
-def _weights(w, n: int, name: str = "weights") -> np.ndarray | None:
-    if w is None:
-        return None
+def _check_weights(w, n: int, name: str = "weights", ok=None) -> np.ndarray:
+    """Return weights (n,) as floats, finite and >= 0 on the rows kept (``ok``).
+
+    Anything else is a ``ValueError`` naming ``name``; rows outside ``ok`` are not
+    checked (they are dropped by the caller).
+    """
     try:
         w = np.asarray(w, float)
     except (TypeError, ValueError):
         raise ValueError(f"{name} must be numeric, got {w!r}") from None
     if w.shape != (n,):
         raise ValueError(f"{name} must have shape ({n},), got {w.shape}")
-    bad = ~np.isfinite(w) | (w < 0)
+    ww = w if ok is None else w[ok]
+    bad = ~np.isfinite(ww) | (ww < 0)
     if np.any(bad):
         raise ValueError(
             f"{name} must be finite and >= 0, got {int(bad.sum())} bad values "
-            f"(first: {w[np.argmax(bad)]!r})"
+            f"(first: {ww[np.argmax(bad)]!r})"
         )
+    return w
+
+
+def _weights(w, n: int, name: str = "weights") -> np.ndarray | None:
+    if w is None:
+        return None
+    w = _check_weights(w, n, name)
     if w.sum() <= 0:
         raise ValueError(f"{name} sum to zero")
     return w
@@ -279,6 +292,7 @@ def vmf_fit(x, weights=None) -> VMFFit:
     Returns
     -------
     VMFFit
+        The fit: μ̂, κ̂, :math:`\bar R` and the total weight.
 
     Raises
     ------
@@ -292,6 +306,17 @@ def vmf_fit(x, weights=None) -> VMFFit:
         When all samples (with non-zero weight) are identical — a single sample
         included: :math:`\bar R = 1` and the MLE :math:`\hat\kappa` is ∞ (returned as
         ``inf``; μ is then the common direction).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from tiltlab import sphere
+    >>> x = sphere.vmf_sample([0.0, 0.0, 1.0], 10.0, 2000, rng=0)
+    >>> fit = sphere.vmf_fit(x)
+    >>> round(fit.kappa, 1), round(fit.rbar, 3)
+    (9.8, 0.898)
+    >>> float(round(np.degrees(sphere.angle(fit.mu, [0.0, 0.0, 1.0])), 1))
+    0.4
     """
     x = as_unit_vectors(x, "x")
     w = _weights(weights, x.shape[0])
@@ -363,16 +388,13 @@ def vmf_logpdf(x, mu, kappa: float) -> np.ndarray:
 
 
 def vmf_pdf(x, mu, kappa: float) -> np.ndarray:
-    """VMF density (sr⁻¹), Eq. 14a.
+    """Evaluate the vMF density (sr⁻¹), Eq. 14a.
 
     Parameters
     ----------
-    x : array_like, shape (..., 3)
-        Directions at which to evaluate the density (normalised here).
-    mu : array_like, shape (3,)
-        Mean direction μ (normalised here).
-    kappa : float
-        Concentration κ ≥ 0, finite.
+    x, mu, kappa : array_like (..., 3), array_like (3,), float
+        As in :func:`vmf_logpdf`: the directions, the mean direction μ and the finite
+        concentration κ ≥ 0.
 
     Returns
     -------
@@ -600,198 +622,3 @@ def vmf_bootstrap(
         float(level),
         angles,
     )
-
-
-# ---------------------------------------------------------------------------
-# mean tilt point, sagittal angle, rotation to the pole
-# ---------------------------------------------------------------------------
-
-
-def _facet_radius(mesh: SphereMesh) -> np.ndarray:
-    """Per facet, the largest chord from its (unit) centroid to its corners."""
-    c = mesh.centroids / np.linalg.norm(mesh.centroids, axis=1, keepdims=True)
-    corners = mesh.vertices[mesh.faces]  # (F, 3, 3)
-    return np.linalg.norm(corners - c[:, None, :], axis=2).max(axis=1)
-
-
-def _map_mesh(tmap: xr.Dataset, mesh: SphereMesh | None) -> SphereMesh | None:
-    """The mesh a tilt-map Dataset was counted on (given, or rebuilt from its
-    ``n_vertices`` attribute), or None when it cannot be known.
-    """
-    n_faces = tmap.sizes.get("facet")
-    if mesh is None and "n_vertices" in tmap.attrs:
-        try:
-            mesh = sphere_mesh(int(tmap.attrs["n_vertices"]))
-        except (TypeError, ValueError):
-            return None
-    if mesh is not None and mesh.n_faces == n_faces:
-        return mesh
-    return None
-
-
-def mean_tilt_point(tmap, mesh: SphereMesh | None = None) -> VMFFit:
-    r"""Average tilt point of a map (Fayat et al. §2.8): vMF fit of the facet centroids weighted by their counts.
-
-    Parameters
-    ----------
-    tmap : xarray.Dataset (from :func:`~tiltlab.sphere.tilt_map`) or array (F,)
-        Samples (or time) per facet.
-    mesh : SphereMesh, optional
-        Needed when ``tmap`` is an array (default the 5000-vertex mesh). For a Dataset
-        it defaults to the mesh named by its ``n_vertices`` attribute.
-
-    Returns
-    -------
-    VMFFit
-
-    Raises
-    ------
-    ValueError
-        As :func:`vmf_fit` when the map has no mean direction: a map symmetric enough
-        that its mean resultant length :math:`\bar R` is within the facets' size. A
-        count stands for samples anywhere in its facet, so replacing them by the
-        centroid moves each by at most the facet radius :math:`\rho_i` (largest chord
-        from the centroid to a corner); the resultant of the samples themselves may
-        then be anywhere within :math:`\bar\rho = \sum_i w_i\rho_i / \sum_i w_i` of the
-        map's. When :math:`\bar R \le \bar\rho` even its direction is not determined
-        by the map (e.g. a uniform map, whose :math:`\bar R` of about 10⁻⁶ only
-        reflects the mesh's irregularity): an error, as :func:`vmf_fit` gives for a
-        zero resultant, rather than an arbitrary direction. For a Dataset whose mesh
-        is unknown, :math:`\rho_i` is estimated from the facet area :math:`A_i` as the
-        circumradius of an equilateral triangle, :math:`\sqrt{4A_i/(3\sqrt3)}`.
-    """
-    if isinstance(tmap, xr.Dataset):
-        c, w = tmap["centroid"].values, tmap["count"].values
-        used = _map_mesh(tmap, mesh)
-        if used is not None:
-            radius = _facet_radius(used)
-        elif "area" in tmap.coords:
-            radius = np.sqrt(
-                4.0 * np.asarray(tmap["area"].values, float) / (3 * np.sqrt(3))
-            )
-        else:
-            radius = None
-    else:
-        mesh = sphere_mesh() if mesh is None else mesh
-        c, w = mesh.centroids, np.asarray(tmap, float)
-        if w.shape != (mesh.n_faces,):
-            raise ValueError(
-                f"tmap has shape {w.shape}, mesh has {mesh.n_faces} facets"
-            )
-        radius = _facet_radius(mesh)
-    w = _weights(w, c.shape[0], "tmap")
-    if radius is not None:
-        x = as_unit_vectors(c, "centroid")
-        rbar = float(np.linalg.norm(w @ x)) / float(w.sum())
-        rho = float(w @ radius) / float(w.sum())
-        if rbar <= rho:
-            raise ValueError(
-                f"tmap: the map has no mean direction: its mean resultant length "
-                f"R̄ = {rbar:.3g} is within the facets' size ({rho:.3g}, the mean facet "
-                "radius), so the direction of its resultant is set by the mesh, not by "
-                "the data (a map symmetric about the centre of the sphere, e.g. "
-                "uniform); vmf_fit raises likewise for a zero resultant"
-            )
-    return vmf_fit(c, w)
-
-
-def sagittal_angle(mu, lesion_side: str = "left") -> np.ndarray:
-    r"""Signed angle (rad) of the tilt direction :math:`\mu` to the sagittal (xz) plane; positive = head tilted toward the lesion side.
-
-    Sensor frame: x nose, y left, z up; :math:`\mu` is the gravity-up direction in that
-    frame. When the head rolls so that its **left** ear goes down, the up direction
-    seen from the head moves toward **−y** (:math:`\mu_y<0`): a tilt toward the lesion
-    side shows as a deviation of the gravity vector *away* from it (Fayat et al. §3.3).
-    Hence
-
-    .. math:: \alpha = \arcsin(-s\,\mu_y),\qquad s = +1 \text{ (left lesion)},\ -1 \text{ (right)},
-
-    so α > 0 means the head is tilted toward the lesioned side. :math:`|\alpha|` is
-    Fayat et al.'s "angular distance to the sagittal plane" (Fig. 4c).
-
-    Parameters
-    ----------
-    mu : array_like, shape (..., 3)
-        Tilt (gravity-up) direction(s) in the sensor frame (normalised here).
-    lesion_side : {"left", "right"}
-        Side of the lesion; sets the sign s.
-
-    Returns
-    -------
-    ndarray, shape (...)
-        Signed angle α (rad), in [−π/2, π/2].
-
-    Raises
-    ------
-    ValueError
-        If ``lesion_side`` is not 'left' or 'right', or ``mu`` has a zero vector.
-    """
-    mu = _validate.vectors(mu, "mu", width=3, ndim=None, allow_nan=True)
-    s = {"left": 1.0, "right": -1.0}.get(lesion_side)
-    if s is None:
-        raise ValueError(f"lesion_side must be 'left' or 'right', got {lesion_side!r}")
-    n = np.linalg.norm(mu, axis=-1, keepdims=True)
-    if np.any(n == 0):
-        raise ValueError("mu contains zero vectors (no direction)")
-    mu = mu / n
-    return np.arcsin(np.clip(-s * mu[..., 1], -1, 1))
-
-
-def rotation_to_pole(point) -> np.ndarray:
-    r"""The minimal rotation matrix R (3×3) with :math:`R\,p = e_z` (about the axis :math:`p\times e_z`).
-
-    Rodrigues' formula; for :math:`p=-e_z` a half-turn about x. ``point`` must be a
-    finite non-zero 3-vector.
-
-    Parameters
-    ----------
-    point : array_like, shape (3,)
-        Direction p to bring to the pole (normalised here).
-
-    Returns
-    -------
-    ndarray, shape (3, 3)
-        Rotation matrix R.
-    """
-    p = _direction(point, "point")
-    ez = np.array([0.0, 0.0, 1.0])
-    c = float(p @ ez)
-    if c < -1 + 1e-15:
-        return np.diag([1.0, -1.0, -1.0])
-    v = np.cross(p, ez)
-    vx = np.array([[0, -v[2], v[1]], [v[2], 0, -v[0]], [-v[1], v[0], 0]])
-    return np.eye(3) + vx + vx @ vx / (1.0 + c)
-
-
-def rotate_to_pole(vectors, baseline):
-    """Rotate directions so that ``baseline`` sits at the north pole (Fayat et al. Fig. 3e).
-
-    Angles between directions are preserved; a point's distance to the pole afterwards
-    is its distance to the baseline point. ``vectors`` of shape (..., 3), or a labelled
-    (time, axis) series / a Recording (its ``gravity``), which gives a DataArray back
-    with the same coordinates and attributes.
-
-    Parameters
-    ----------
-    vectors : array_like (..., 3), xarray.DataArray or xarray.Dataset
-        Directions to rotate (NaN rows stay NaN).
-    baseline : array_like, shape (3,)
-        Direction brought to the north pole (normalised here).
-
-    Returns
-    -------
-    ndarray, shape (..., 3), or xarray.DataArray
-        Rotated directions; a (time, axis) DataArray for labelled input.
-    """
-    R = rotation_to_pole(_direction(baseline, "baseline"))
-    if isinstance(vectors, (xr.DataArray, xr.Dataset)):
-        sig = _read(vectors, allow_nan=True)
-        out = sig.values @ R.T
-        attrs = {"units": "1", "long_name": "direction, baseline at the pole"}
-        if "method" in sig.attrs:
-            attrs["method"] = sig.attrs["method"]
-        return _validate.labelled(
-            out, sig, "rotated", dims=("time", "axis"), attrs=attrs
-        )
-    v = _validate.vectors(vectors, "vectors", width=3, ndim=None, allow_nan=True)
-    return v @ R.T
