@@ -1,4 +1,6 @@
-r"""Sensor calibration and drift: still periods, accelerometer sphere/ellipsoid fits,
+r"""Sensor calibration and drift: still periods, fits, offsets, clocks and alignment.
+
+Sensor calibration and drift: still periods, accelerometer sphere/ellipsoid fits,
 gyroscope offsets and drift, tumble-test design, temperature models, magnetometer
 calibration, clocks between streams and frame alignment.
 
@@ -17,6 +19,8 @@ Submodules (all public names are re-exported here):
   :func:`tiltlab.dsp.still_mask`), per-period statistics, gyro offsets;
 * :mod:`~tiltlab.calibration.accel` — Fayat offset fit, 9-parameter ellipsoid fit,
   12-parameter known-direction fit, Fibonacci lattice and stage angles;
+* :mod:`~tiltlab.calibration.orientations` — tumble-test design: lattice subsets,
+  orientation-count studies, systematic offset uncertainty;
 * :mod:`~tiltlab.calibration.temperature` — polynomial offset-vs-temperature models;
 * :mod:`~tiltlab.calibration.drift` — integrated static angles, LaCanna's three drift
   corrections, Allan deviation;
@@ -42,6 +46,8 @@ from .drift import *  # noqa: F401,F403
 from .drift import __all__ as _d
 from .magnetometer import *  # noqa: F401,F403
 from .magnetometer import __all__ as _f
+from .orientations import *  # noqa: F401,F403
+from .orientations import __all__ as _o
 from .static import *  # noqa: F401,F403
 from .static import __all__ as _g
 from .summaries import *  # noqa: F401,F403
@@ -49,4 +55,4 @@ from .summaries import __all__ as _s
 from .temperature import *  # noqa: F401,F403
 from .temperature import __all__ as _h
 
-__all__ = ["CalibrationError", *_a, *_e, *_b, *_c, *_d, *_f, *_g, *_h, *_s]
+__all__ = ["CalibrationError", *_a, *_e, *_b, *_c, *_d, *_f, *_o, *_g, *_h, *_s]

@@ -21,6 +21,7 @@ __all__ = [
     "mat3",
     "read_in",
     "read_temp_degc",
+    "window_count",
 ]
 
 
@@ -29,12 +30,40 @@ class CalibrationError(ValueError):
 
 
 def vec3(x, name: str, *, ndim: int | None = None) -> np.ndarray:
-    """A finite float copy of ``x`` with a last dimension of 3 (and ``ndim`` dims)."""
+    """Check ``x`` as 3-vectors: a finite float copy with a last dimension of 3.
+
+    Parameters
+    ----------
+    x : array_like, shape (..., 3)
+        The vectors.
+    name : str
+        Name used in error messages.
+    ndim : int, optional
+        Required number of dimensions.
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., 3)
+        Finite float copy of ``x``.
+    """
     return _v.vectors(x, name, width=3, ndim=ndim)
 
 
 def mat3(x, name: str) -> np.ndarray:
-    """A finite (3, 3) float matrix."""
+    """Check ``x`` as a finite (3, 3) float matrix.
+
+    Parameters
+    ----------
+    x : array_like, shape (3, 3)
+        The matrix.
+    name : str
+        Name used in error messages.
+
+    Returns
+    -------
+    numpy.ndarray, shape (3, 3)
+        ``x`` as floats.
+    """
     m = np.asarray(x, dtype=float)
     if m.shape != (3, 3):
         raise ValueError(f"{name} must be a 3x3 matrix, got shape {m.shape}")
@@ -62,6 +91,27 @@ def read_in(
     or, if that is ``None``, already in ``target`` (the unit tiltlab Recordings use:
     ``"deg/s"`` for gyroscopes, ``"g"`` for accelerometers), as documented by every
     public function that calls this.
+
+    Parameters
+    ----------
+    data : Recording, DataArray or array_like
+        The input (for a Recording, its variable ``var`` or ``name``).
+    name : str
+        Name of the input (error messages; a Recording's variable by default).
+    target : str
+        Units to convert to.
+    fs : float, optional
+        Sampling rate (Hz) of a plain array.
+    units : str, optional
+        Units of a plain array (default ``target``).
+    var : str, optional
+        Variable read from a Recording.
+    need_fs : bool
+        Whether a sampling rate is required.
+    width, ndim : int or None
+        Required last dimension and number of dimensions.
+    allow_nan : bool
+        Accept NaN samples (gaps).
 
     Returns
     -------
@@ -101,7 +151,22 @@ def read_in(
 
 
 def read_temp_degc(temp, n: int | None = None, name: str = "temp") -> np.ndarray:
-    """Temperatures in °C from a labelled (``degC`` or ``K``) or plain (°C) input."""
+    """Read temperatures in °C from a labelled (``degC`` or ``K``) or plain (°C) input.
+
+    Parameters
+    ----------
+    temp : DataArray or array_like, shape (N,)
+        Temperatures.
+    n : int, optional
+        Required number of samples.
+    name : str
+        Name used in error messages.
+
+    Returns
+    -------
+    numpy.ndarray, shape (N,)
+        Temperatures (°C).
+    """
     s = _v.signal(temp, name, need_fs=False, width=None, ndim=1)
     t = s.values
     if s.units is not None and s.units == "K":
@@ -115,3 +180,43 @@ def read_temp_degc(temp, n: int | None = None, name: str = "temp") -> np.ndarray
             f"{name} must have one value per sample ({n}), got shape {t.shape}"
         )
     return t
+
+
+def window_count(
+    n: int, window_s: float, fs: float, minimum: int, what: tuple[str, str]
+) -> tuple[int, int]:
+    """Cut ``n`` samples into whole windows of ``window_s`` seconds.
+
+    Parameters
+    ----------
+    n : int
+        Number of samples.
+    window_s : float
+        Window length (s).
+    fs : float
+        Sampling rate (Hz).
+    minimum : int
+        Fewest samples in a window.
+    what : tuple of 2 str
+        What is cut (``"recording"``) and the end of the error message.
+
+    Returns
+    -------
+    w : int
+        Samples per window (``round(window_s * fs)``, at least ``minimum``).
+    k : int
+        Number of whole windows (at least 1).
+
+    Raises
+    ------
+    CalibrationError
+        Fewer than ``w`` samples.
+    """
+    w = max(int(round(window_s * fs)), minimum)
+    k = n // w
+    if k < 1:
+        raise CalibrationError(
+            f"the {what[0]} ({n} samples) is shorter than one window of "
+            f"window_s = {window_s:g} s{what[1]}"
+        )
+    return w, k

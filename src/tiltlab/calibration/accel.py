@@ -1,4 +1,6 @@
-r"""Accelerometer calibration from static poses: offset-only sphere fit, ellipsoid fit,
+r"""Accelerometer calibration from static poses, and tumble-test design.
+
+Accelerometer calibration from static poses: offset-only sphere fit, ellipsoid fit,
 known-direction linear fit, and tumble-test design (Fibonacci lattice, stage angles).
 
 Sensor model
@@ -34,7 +36,6 @@ References
 
 from __future__ import annotations
 
-from itertools import combinations
 from typing import NamedTuple
 
 import numpy as np
@@ -57,11 +58,6 @@ __all__ = [
     "fibonacci_lattice",
     "stage_angles",
     "stage_quaternion",
-    "offset_systematic_uncertainty",
-    "lattice_subset",
-    "triplet_orthogonality",
-    "all_subsets",
-    "orientation_count_study",
 ]
 
 
@@ -86,6 +82,16 @@ def _points(
             f"away from {radius:g}: saturated, moving, or wrong units"
         )
     return p
+
+
+def _sem(sem, p: np.ndarray) -> np.ndarray | None:
+    # standard errors of the points, checked against their shape (None passes)
+    if sem is None:
+        return None
+    se = vec3(sem, "sem", ndim=2)
+    if se.shape != p.shape:
+        raise ValueError("sem must have the same shape as points")
+    return se
 
 
 def norm_error(points, offset=None, matrix=None, radius: float = 1.0) -> np.ndarray:
@@ -126,7 +132,9 @@ def _condition_or_raise(J, what, max_condition):
 
 
 class OffsetFit(NamedTuple):
-    """Offset-only fit: ``offset`` (3,), ``stderr`` (3,), ``cov`` (3, 3), ``residuals``
+    """Result of :func:`fit_offsets`.
+
+    Offset-only fit: ``offset`` (3,), ``stderr`` (3,), ``cov`` (3, 3), ``residuals``
     (P,) signed norm errors at the solution, ``mean_abs_error`` (mean of |1 − ‖a − o‖|),
     ``condition`` (Jacobian condition number) and ``n`` (poses).
     """
@@ -166,6 +174,10 @@ def fit_offsets(
         Largest accepted condition number of the Jacobian (unit directions); above it
         the orientations cannot determine the offsets and :class:`CalibrationError` is
         raised.
+    max_norm_deviation : float
+        Largest accepted relative deviation of a pose's norm from ``radius`` (0.25:
+        25 %); a larger one (saturated, moving, wrong units) raises
+        :class:`CalibrationError`.
 
     Returns
     -------
@@ -183,10 +195,7 @@ def fit_offsets(
     max_condition = _v.positive(max_condition, "max_condition")
     x0 = np.zeros(3) if x0 is None else vec3(x0, "x0", ndim=1)
     w = np.ones(p.shape[0])
-    if sem is not None:
-        se = vec3(sem, "sem", ndim=2)
-        if se.shape != p.shape:
-            raise ValueError("sem must have the same shape as points")
+    se = _sem(sem, p)
 
     def resid(o):
         return (np.linalg.norm(p - o, axis=1) - radius) * w
@@ -228,6 +237,12 @@ def fit_offsets_batch(
     points : array_like (B, k, 3)
         B sets of k static means each (k ≥ 2; k = 2 is underdetermined and the damped
         iteration started at zero returns the solution closest to zero along its path).
+    radius : float
+        Expected norm (1 g).
+    iterations : int
+        Largest number of Gauss–Newton steps.
+    damping : float
+        Levenberg damping, relative to the trace of :math:`J^\top J`.
 
     Returns
     -------
@@ -284,7 +299,9 @@ def identifiable_matrix(matrix) -> np.ndarray:
 
 
 class EllipsoidFit(NamedTuple):
-    """Ellipsoid fit: ``offset`` (3,), ``matrix`` C (3, 3) with ‖C(y − o)‖ ≈ r,
+    """Result of :func:`fit_ellipsoid`.
+
+    Ellipsoid fit: ``offset`` (3,), ``matrix`` C (3, 3) with ‖C(y − o)‖ ≈ r,
     ``params``/``stderr`` (9,) [o (3), then the free entries of C: upper triangle row-major
     for "triangular", (xx, xy, xz, yy, yz, zz) for "symmetric"], ``offset_stderr`` (3,),
     ``matrix_stderr`` (3, 3), ``cov`` (9, 9), ``residuals`` (P,), ``mean_abs_error``,
@@ -345,50 +362,8 @@ def _algebraic_quadric(p):
     return A, b, c, m, s, sv
 
 
-def fit_ellipsoid(
-    points,
-    *,
-    radius: float = 1.0,
-    sem=None,
-    structure: str = "triangular",
-    max_condition: float = 1e4,
-    max_norm_deviation: float = 0.25,
-) -> EllipsoidFit:
-    r"""Nine-parameter ellipsoid fit :math:`\|C(y_p - o)\| = r` (offsets, scales, misalignment).
-
-    Parameters
-    ----------
-    points : array_like (P, 3)
-        Static readings (P ≥ 9, well spread over the sphere; 10 or more give residual
-        degrees of freedom for uncertainties without ``sem``).
-    radius : float
-        Norm of the true vector (1 for an accelerometer in g; the field strength for a
-        magnetometer).
-    sem : array_like (P, 3), optional
-        Standard errors of the points; weights and uncertainty propagation.
-    structure : {"triangular", "symmetric"}
-        Gauge of C (see module notes).
-    max_condition : float
-        Largest accepted condition number of the (normalised) Jacobian.
-
-    Returns
-    -------
-    EllipsoidFit
-
-    Notes
-    -----
-    Linear step: the algebraic quadric :math:`y^\top A y + b^\top y + c = 0` is the
-    right-singular vector of the smallest singular value of the design matrix built
-    from the centred, scaled points; :math:`o = -A^{-1}b/2`, :math:`M = A/(o^\top A o - c)`,
-    :math:`C = \mathrm{chol}(M)^\top` (or :math:`M^{1/2}`), times r. Then
-    :func:`scipy.optimize.least_squares` (LM) minimises the geometric residuals.
-    """
-    if structure not in ("triangular", "symmetric"):
-        raise ValueError(
-            f"structure must be 'triangular' or 'symmetric', got {structure!r}"
-        )
-    p = _points(points, radius, min_n=9, max_norm_deviation=max_norm_deviation)
-    max_condition = _v.positive(max_condition, "max_condition")
+def _ellipsoid_start(p, radius, structure, max_condition) -> np.ndarray:
+    # the algebraic (linear) fit: starting parameters [o, free entries of C]
     A, b, c, m, s, sv = _algebraic_quadric(p)
     # second-smallest singular value small -> the quadric is not unique (poses too few/degenerate)
     if sv.size < 10 or sv[-2] / sv[0] < 1.0 / max_condition:
@@ -417,56 +392,115 @@ def fit_ellipsoid(
         w, V = np.linalg.eigh(M)
         C0 = (V * np.sqrt(w)) @ V.T
     C0 = C0 * radius
-    v0 = np.concatenate([o, [C0[i, j] for i, j in _TRI]])
-    wts = np.ones(p.shape[0])
-    if sem is not None:
-        se = vec3(sem, "sem", ndim=2)
-        if se.shape != p.shape:
-            raise ValueError("sem must have the same shape as points")
+    return np.concatenate([o, [C0[i, j] for i, j in _TRI]])
 
+
+def _ellipsoid_resid(v, p, radius, structure):
+    # geometric residuals ||C (p - o)|| - r
+    return np.linalg.norm((p - v[:3]) @ _c_from(v[3:], structure).T, axis=1) - radius
+
+
+def _ellipsoid_jac(v, p, structure):
+    # Jacobian of _ellipsoid_resid with respect to v (P, 9)
+    o_, C = v[:3], _c_from(v[3:], structure)
+    d = p - o_
+    x = d @ C.T
+    nx = np.linalg.norm(x, axis=1, keepdims=True)
+    u = x / nx  # d r / d x
+    J = np.empty((p.shape[0], 9))
+    J[:, :3] = -(u @ C)
+    for col, (i, j) in enumerate(_TRI):
+        g = u[:, i] * d[:, j]
+        if structure == "symmetric" and i != j:
+            g = g + u[:, j] * d[:, i]
+        J[:, 3 + col] = g
+    return J
+
+
+def _ellipsoid_refine(p, radius, structure, v0, se) -> tuple[np.ndarray, np.ndarray]:
+    # least-squares refinement of the geometric residuals; with standard errors ``se``
+    # a first unweighted pass gives the weights of the second. Returns (v, weights).
     def resid(v):
-        return (
-            np.linalg.norm((p - v[:3]) @ _c_from(v[3:], structure).T, axis=1) - radius
-        )
+        return _ellipsoid_resid(v, p, radius, structure)
 
     def jac(v):
-        o_, C = v[:3], _c_from(v[3:], structure)
-        d = p - o_
-        x = d @ C.T
-        nx = np.linalg.norm(x, axis=1, keepdims=True)
-        u = x / nx  # d r / d x
-        J = np.empty((p.shape[0], 9))
-        J[:, :3] = -(u @ C)
-        for col, (i, j) in enumerate(_TRI):
-            g = u[:, i] * d[:, j]
-            if structure == "symmetric" and i != j:
-                g = g + u[:, j] * d[:, i]
-            J[:, 3 + col] = g
-        return J
+        return _ellipsoid_jac(v, p, structure)
 
-    if sem is not None:
-        sol0 = least_squares(resid, v0, jac=jac, method="lm", xtol=1e-15, ftol=1e-15)
-        u0 = (p - sol0.x[:3]) @ _c_from(sol0.x[3:], structure).T
-        u0 /= np.linalg.norm(u0, axis=1, keepdims=True)
-        Cs = _c_from(sol0.x[3:], structure)
-        gp = u0 @ Cs  # d r_p / d y_p
-        var = np.sum(gp * gp * se * se, axis=1)
-        wts = 1.0 / np.sqrt(var)
-        sol = least_squares(
-            lambda v: resid(v) * wts,
-            sol0.x,
-            jac=lambda v: jac(v) * wts[:, None],
-            method="lm",
-            xtol=1e-15,
-            ftol=1e-15,
-        )
-    else:
+    if se is None:
         sol = least_squares(resid, v0, jac=jac, method="lm", xtol=1e-15, ftol=1e-15)
-    v = sol.x
-    J = jac(v) * wts[:, None]
+        return sol.x, np.ones(p.shape[0])
+    sol0 = least_squares(resid, v0, jac=jac, method="lm", xtol=1e-15, ftol=1e-15)
+    u0 = (p - sol0.x[:3]) @ _c_from(sol0.x[3:], structure).T
+    u0 /= np.linalg.norm(u0, axis=1, keepdims=True)
+    Cs = _c_from(sol0.x[3:], structure)
+    gp = u0 @ Cs  # d r_p / d y_p
+    var = np.sum(gp * gp * se * se, axis=1)
+    wts = 1.0 / np.sqrt(var)
+    sol = least_squares(
+        lambda v: resid(v) * wts,
+        sol0.x,
+        jac=lambda v: jac(v) * wts[:, None],
+        method="lm",
+        xtol=1e-15,
+        ftol=1e-15,
+    )
+    return sol.x, wts
+
+
+def fit_ellipsoid(
+    points,
+    *,
+    radius: float = 1.0,
+    sem=None,
+    structure: str = "triangular",
+    max_condition: float = 1e4,
+    max_norm_deviation: float = 0.25,
+) -> EllipsoidFit:
+    r"""Nine-parameter ellipsoid fit :math:`\|C(y_p - o)\| = r` (offsets, scales, misalignment).
+
+    Parameters
+    ----------
+    points : array_like (P, 3)
+        Static readings (P ≥ 9, well spread over the sphere; 10 or more give residual
+        degrees of freedom for uncertainties without ``sem``).
+    radius : float
+        Norm of the true vector (1 for an accelerometer in g; the field strength for a
+        magnetometer).
+    sem : array_like (P, 3), optional
+        Standard errors of the points; weights and uncertainty propagation.
+    structure : {"triangular", "symmetric"}
+        Gauge of C (see module notes).
+    max_condition : float
+        Largest accepted condition number of the (normalised) Jacobian.
+    max_norm_deviation : float
+        Largest accepted relative deviation of a pose's norm from ``radius``, as in
+        :func:`fit_offsets`.
+
+    Returns
+    -------
+    EllipsoidFit
+
+    Notes
+    -----
+    Linear step: the algebraic quadric :math:`y^\top A y + b^\top y + c = 0` is the
+    right-singular vector of the smallest singular value of the design matrix built
+    from the centred, scaled points; :math:`o = -A^{-1}b/2`, :math:`M = A/(o^\top A o - c)`,
+    :math:`C = \mathrm{chol}(M)^\top` (or :math:`M^{1/2}`), times r. Then
+    :func:`scipy.optimize.least_squares` (LM) minimises the geometric residuals.
+    """
+    if structure not in ("triangular", "symmetric"):
+        raise ValueError(
+            f"structure must be 'triangular' or 'symmetric', got {structure!r}"
+        )
+    p = _points(points, radius, min_n=9, max_norm_deviation=max_norm_deviation)
+    max_condition = _v.positive(max_condition, "max_condition")
+    v0 = _ellipsoid_start(p, radius, structure, max_condition)
+    se = _sem(sem, p)
+    v, wts = _ellipsoid_refine(p, radius, structure, v0, se)
+    J = _ellipsoid_jac(v, p, structure) * wts[:, None]
     Jn = J / np.linalg.norm(J, axis=0)
     cond = _condition_or_raise(Jn, "9-parameter ellipsoid", max_condition)
-    r = resid(v)
+    r = _ellipsoid_resid(v, p, radius, structure)
     JtJi = np.linalg.inv(J.T @ J)
     if sem is not None:
         cov = JtJi
@@ -496,7 +530,9 @@ def fit_ellipsoid(
 
 
 class LinearFit(NamedTuple):
-    """Known-direction fit :math:`y = T g + o`: ``offset`` (3,), ``sensor_matrix`` T,
+    """Result of :func:`fit_known_directions`.
+
+    Known-direction fit :math:`y = T g + o`: ``offset`` (3,), ``sensor_matrix`` T,
     ``matrix`` C = T⁻¹, ``offset_stderr`` (3,), ``sensor_matrix_stderr`` (3, 3),
     ``residuals`` (P, 3), ``n``.
     """
@@ -570,228 +606,3 @@ def fit_known_directions(
 
 # The lattice and the stage geometry are implemented once, in tiltlab.frames
 # (Fayat App. A.1); calibration re-exports them under the names used in its chapter.
-
-
-def lattice_subset(directions, k: int) -> np.ndarray:
-    """Indices of ``k`` of the given directions best matching a k-point Fibonacci lattice
-    (greedy nearest neighbour, each direction used once; Fayat Fig. 1c for N ≥ 5).
-
-    Parameters
-    ----------
-    directions : array_like, shape (N, 3)
-        Candidate unit directions (e.g. the poses of a tumble test).
-    k : int
-        Number of directions to choose, ``1 <= k <= N``.
-
-    Returns
-    -------
-    numpy.ndarray of int64, shape (k,)
-        Indices into ``directions``, in lattice order.
-    """
-    d = vec3(directions, "directions", ndim=2)
-    k = _v.integer(k, "k", minimum=1)
-    if k > d.shape[0]:
-        raise ValueError(f"k must be between 1 and {d.shape[0]}, got {k}")
-    target = fibonacci_lattice(k)
-    free = np.ones(d.shape[0], bool)
-    out = []
-    for t in target:
-        score = np.where(free, d @ t, -np.inf)
-        j = int(np.argmax(score))
-        out.append(j)
-        free[j] = False
-    return np.array(out, dtype=np.int64)
-
-
-def triplet_orthogonality(directions) -> np.ndarray:
-    r"""|det[u_1 u_2 u_3]| of unit directions (…, 3, 3): 1 for mutually orthogonal, 0 for coplanar.
-
-    Parameters
-    ----------
-    directions : array_like, shape (..., 3, 3)
-        Triplets of directions (rows; normalised here, any non-zero length).
-
-    Returns
-    -------
-    numpy.ndarray, shape (...)
-        The absolute determinant, in [0, 1].
-
-    Raises
-    ------
-    ValueError
-        If a direction is a zero vector.
-    """
-    d = vec3(directions, "directions")
-    nd = np.linalg.norm(d, axis=-1, keepdims=True)
-    if np.any(nd == 0):
-        raise ValueError("directions has zero vectors: their direction is undefined")
-    u = d / nd
-    return np.abs(np.linalg.det(u))
-
-
-def all_subsets(
-    n: int, k: int, *, max_subsets: int | None = None, rng=None
-) -> np.ndarray:
-    """All k-subsets of range(n) as an int array (S, k), or ``max_subsets`` of them drawn at random.
-
-    Parameters
-    ----------
-    n : int
-        Size of the set, ``range(n)``.
-    k : int
-        Size of each subset.
-    max_subsets : int, optional
-        If there are more than this many subsets, draw this many at random (with
-        replacement between draws, so duplicates are possible); default all.
-    rng : int or numpy.random.Generator, optional
-        Seed or generator for the random draw.
-
-    Returns
-    -------
-    numpy.ndarray of int64, shape (S, k)
-        One subset per row, indices sorted within each row.
-    """
-    from math import comb
-
-    n = _v.integer(n, "n", minimum=0)
-    k = _v.integer(k, "k", minimum=0)
-    if max_subsets is not None:
-        max_subsets = _v.integer(max_subsets, "max_subsets", minimum=1)
-    total = comb(n, k)
-    if max_subsets is None or total <= max_subsets:
-        return np.array(list(combinations(range(n), k)), dtype=np.int64).reshape(-1, k)
-    rng = np.random.default_rng(rng)
-    return np.sort(
-        np.array([rng.choice(n, k, replace=False) for _ in range(max_subsets)]), axis=1
-    )
-
-
-def offset_systematic_uncertainty(
-    points,
-    *,
-    scale_sd: float = 0.01,
-    misalign_sd: float = 0.005,
-    n_draws: int = 2000,
-    radius: float = 1.0,
-    rng=None,
-) -> tuple[np.ndarray, np.ndarray]:
-    r"""Spread of offset-only solutions over plausible, unmodelled scale/misalignment errors.
-
-    With few poses (e.g. a three-point test) the offsets absorb the scale errors: if the
-    sensor matrix is :math:`T`, the offsets consistent with the same static means are
-    :math:`o = T o'` where :math:`o'` solves the offset fit on :math:`T^{-1}a_p`.
-    Drawing :math:`T = (I + \mathrm{diag}(s))(I + E)` with :math:`s \sim N(0, \sigma_s)`,
-    off-diagonal :math:`E \sim N(0, \sigma_m)` gives the systematic uncertainty that the
-    data cannot remove.
-
-    Parameters
-    ----------
-    points : array_like, shape (P, 3)
-        Static accelerometer means (units of ``radius``, e.g. g), P ≥ 3.
-    scale_sd : float
-        Standard deviation :math:`\sigma_s` of the scale errors (fraction, e.g. 0.01 for
-        1 %).
-    misalign_sd : float
-        Standard deviation :math:`\sigma_m` of the off-diagonal misalignment terms
-        (radians, small-angle).
-    n_draws : int
-        Number of drawn matrices T (≥ 2).
-    radius : float
-        Norm of the readings at rest (1 for g).
-    rng : int or numpy.random.Generator, optional
-        Seed or generator for the draws.
-
-    Returns
-    -------
-    offsets : ndarray (n_draws, 3)
-        Offset solutions under each drawn T.
-    sd : ndarray (3,)
-        Their standard deviation per axis.
-    """
-    p = _points(points, radius, min_n=3)
-    scale_sd = _v.nonnegative(scale_sd, "scale_sd")
-    misalign_sd = _v.nonnegative(misalign_sd, "misalign_sd")
-    n_draws = _v.integer(n_draws, "n_draws", minimum=2)
-    rng = np.random.default_rng(rng)
-    s = rng.normal(0.0, scale_sd, (n_draws, 3))
-    E = rng.normal(0.0, misalign_sd, (n_draws, 3, 3)) * (1 - np.eye(3))
-    T = (np.eye(3) + s[:, :, None] * np.eye(3)) @ (np.eye(3) + E)
-    Ti = np.linalg.inv(T)
-    z = np.einsum("bij,pj->bpi", Ti, p)
-    o_prime = fit_offsets_batch(z, radius=radius)
-    o = np.einsum("bij,bj->bi", T, o_prime)
-    return o, o.std(axis=0, ddof=1)
-
-
-def orientation_count_study(
-    means, directions, ns, *, radius: float = 1.0, max_subsets: int = 5000, rng=None
-) -> list[dict]:
-    r"""Residual norm error versus the number N of orientations used for the offsets (Fayat Fig. 1c).
-
-    For each N, offsets are fitted (:func:`fit_offsets_batch`) on a subset of the P poses
-    and evaluated on *all* poses as :math:`\frac1P\sum_p |r - \|a_p - o\||`. For N ≥ 4
-    the subset best matching an N-point Fibonacci lattice is used (:func:`lattice_subset`);
-    for N ≤ 3 all subsets (or ``max_subsets`` random ones) are evaluated and the
-    distribution summarised by its median and by the value at the most orthogonal subset.
-
-    Parameters
-    ----------
-    means : array_like (P, 3)
-        Static means of one tumble test.
-    directions : array_like (P, 3)
-        Target gravity directions of the poses (for subset selection).
-    ns : iterable of int
-
-    Returns
-    -------
-    list of dict
-        One record per N: ``n``, ``residual`` (lattice subset, or orthogonal subset for
-        N ≤ 3), ``residual_median`` (over subsets for N ≤ 3), ``orthogonality``.
-    """
-    p = _points(means, radius, name="means", min_n=3)
-    d = vec3(directions, "directions", ndim=2)
-    rng = np.random.default_rng(rng)
-
-    def resid(o):
-        return np.mean(
-            np.abs(np.linalg.norm(p[None] - o[:, None, :], axis=2) - radius), axis=1
-        )
-
-    out = []
-    for n in ns:
-        n = int(n)
-        if n <= 3:
-            sub = all_subsets(p.shape[0], n, max_subsets=max_subsets, rng=rng)
-            r = resid(fit_offsets_batch(p[sub], radius=radius))
-            if n == 3:
-                orth = triplet_orthogonality(d[sub])
-                k = int(np.argmax(orth))
-                out.append(
-                    {
-                        "n": n,
-                        "residual": float(r[k]),
-                        "residual_median": float(np.median(r)),
-                        "orthogonality": float(orth[k]),
-                    }
-                )
-            else:
-                out.append(
-                    {
-                        "n": n,
-                        "residual": float(np.median(r)),
-                        "residual_median": float(np.median(r)),
-                        "orthogonality": float("nan"),
-                    }
-                )
-        else:
-            idx = lattice_subset(d, n)
-            r = resid(fit_offsets_batch(p[idx][None], radius=radius))[0]
-            out.append(
-                {
-                    "n": n,
-                    "residual": float(r),
-                    "residual_median": float(r),
-                    "orthogonality": float("nan"),
-                }
-            )
-    return out

@@ -1,4 +1,6 @@
-r"""Frame alignment: head frame from motion-capture markers, marker quality control,
+r"""Frame alignment: head frame from markers, marker QC, IMU-to-head and mounting.
+
+Frame alignment: head frame from motion-capture markers, marker quality control,
 IMU-to-head alignment (Kabsch) and device-to-body mounting angles.
 
 The geometry itself (marker head frame, Benhamou's mounting angles) is implemented once,
@@ -38,6 +40,7 @@ from scipy.spatial.transform import Rotation
 
 from .. import _validate as _v
 from .. import frames as _frames
+from ..frames import head_frame_from_markers
 from .. import quaternion as _quat
 from ..dsp import lowpass
 from ._util import CalibrationError, vec3
@@ -54,48 +57,11 @@ __all__ = [
 ]
 
 
-def head_frame_from_markers(p1, p2, p3) -> np.ndarray:
-    """Head→world rotation matrices (…, 3, 3) whose columns are h_x, h_y, h_z (Fayat §2.6.4).
-
-    Frames with a missing (NaN) marker give NaN matrices.
-
-    Validates the markers, then calls the single implementation,
-    :func:`tiltlab.frames.head_frame_from_markers`.
-
-    Parameters
-    ----------
-    p1, p2, p3 : array_like, shape (..., 3)
-        Positions of the three head markers (world frame, any length unit); NaN marks
-        a missing marker.
-
-    Returns
-    -------
-    numpy.ndarray, shape (..., 3, 3)
-        Head→world rotation matrices.
-
-    Raises
-    ------
-    CalibrationError
-        Coincident or collinear markers.
-    """
-    a, b, c = (np.asarray(p, float) for p in (p1, p2, p3))
-    if a.shape != b.shape or a.shape != c.shape or a.shape[-1] != 3:
-        raise ValueError("p1, p2, p3 must have the same shape (..., 3)")
-    v21, v23 = a - b, c - b
-    n21 = np.linalg.norm(v21, axis=-1)
-    ncz = np.linalg.norm(np.cross(v23, v21), axis=-1)
-    ok = np.isfinite(ncz)  # frames with a missing (NaN) marker give NaN
-    if np.any(n21[ok] == 0) or np.any(
-        ncz[ok] <= 1e-9 * n21[ok] * np.linalg.norm(v23, axis=-1)[ok]
-    ):
-        raise CalibrationError(
-            "coincident or collinear markers: the head frame is undefined"
-        )
-    return _frames.head_frame_from_markers(a, b, c)
-
-
 def tilt_from_markers(p1, p2, p3) -> np.ndarray:
-    """Head tilt: the world vertical m_z in head coordinates, R(head)ᵀ e_z (…, 3).
+    """Compute the head tilt: the world vertical m_z in head coordinates, R(head)ᵀ e_z.
+
+    The head frame is :func:`tiltlab.frames.head_frame_from_markers` (also exported
+    here), which raises ``ValueError`` for coincident or collinear markers.
 
     Parameters
     ----------
@@ -113,7 +79,9 @@ def tilt_from_markers(p1, p2, p3) -> np.ndarray:
 
 
 class MarkerQC(NamedTuple):
-    """``keep`` (N,) frames kept, ``distance`` (N,) d₁₂, ``median``, ``sigma_all``,
+    """Result of :func:`marker_distance_qc`.
+
+    ``keep`` (N,) frames kept, ``distance`` (N,) d₁₂, ``median``, ``sigma_all``,
     ``sigma_kept`` (units of the markers), ``tilt_uncertainty_deg``.
     """
 
@@ -194,7 +162,9 @@ def marker_distance_qc(p1, p2, *, drop_fraction: float = 0.02) -> MarkerQC:
 
 
 class Alignment(NamedTuple):
-    """``matrix`` (3, 3) IMU→head rotation, ``quaternion`` (4,), ``rms_deg`` RMS angle
+    """Result of :func:`imu_to_head_alignment`.
+
+    ``matrix`` (3, 3) IMU→head rotation, ``quaternion`` (4,), ``rms_deg`` RMS angle
     between aligned IMU gravity and head vertical, ``n`` samples used.
     """
 
@@ -213,7 +183,9 @@ def imu_to_head_alignment(
     cutoff_hz: float = 2.0,
     min_spread_deg: float = 5.0,
 ) -> Alignment:
-    r"""Rotation R (IMU→head) minimising :math:`\sum_t \|R\,\hat a_t - z^h_t\|^2` over
+    r"""Find the IMU→head rotation that aligns still accelerations with the head vertical.
+
+    Rotation R (IMU→head) minimising :math:`\sum_t \|R\,\hat a_t - z^h_t\|^2` over
     still samples (Kabsch).
 
     Parameters
@@ -235,6 +207,12 @@ def imu_to_head_alignment(
         The rotation about a single gravity direction is unobservable: the used tilts
         must spread over at least this angle (°) from their mean, else
         :class:`CalibrationError`.
+
+    Returns
+    -------
+    Alignment
+        The IMU→head rotation (``matrix``, ``quaternion``), the RMS angle (°) between
+        aligned IMU gravity and head vertical, and the number of samples used.
     """
     sa = _v.signal(acc, "acc", fs=fs)
     a, fs = sa.values, sa.fs

@@ -32,7 +32,9 @@ __all__ = ["LagEstimate", "estimate_lag", "SlipRepair", "repair_ttl_slips"]
 
 
 class LagEstimate(NamedTuple):
-    """``lag_s`` (s; positive when ``y`` lags ``x``, i.e. y(t) ≈ x(t − lag)), ``lag_samples``
+    """Result of :func:`estimate_lag`.
+
+    ``lag_s`` (s; positive when ``y`` lags ``x``, i.e. y(t) ≈ x(t − lag)), ``lag_samples``
     (in samples of ``fs``), ``correlation`` (normalised correlation at the lag).
     """
 
@@ -137,7 +139,9 @@ def estimate_lag(
 
 
 class SlipRepair(NamedTuple):
-    """``mocap`` aligned mocap samples, one per IMU sample of ``imu_index``; ``imu_index``
+    """Result of :func:`repair_ttl_slips`.
+
+    ``mocap`` aligned mocap samples, one per IMU sample of ``imu_index``; ``imu_index``
     (M,) IMU sample indices covered (from the first to the last timestamp); ``n_duplicated``
     and ``n_deleted`` cycle corrections; ``cycle_lengths`` IMU samples between timestamps.
     """
@@ -163,6 +167,8 @@ def repair_ttl_slips(
         at mocap frame ``first_frame + k * cycle``.
     cycle : int
         Mocap frames per TTL (6 in Fayat et al.: 300 Hz video, 50 Hz TTL).
+    first_frame : int
+        Mocap frame of the first TTL.
     max_slip : int
         Largest accepted |IMU samples − cycle| per cycle; larger gaps (a lost TTL, a
         wrong ``cycle``) raise :class:`CalibrationError` instead of being "repaired".

@@ -76,7 +76,9 @@ def _integrate(g: np.ndarray, fs: float) -> np.ndarray:
 
 
 def integrate_rate(gyr, fs: float | None = None, *, units: str | None = None):
-    r"""Per-axis integrated angle (°) of a rate, :math:`\theta_k = \sum_{j<k}\omega_j/f_s`,
+    r"""Integrate a rate per axis into an angle (°).
+
+    Per-axis integrated angle (°) of a rate, :math:`\theta_k = \sum_{j<k}\omega_j/f_s`,
     θ₀ = 0.
 
     This is LaCanna's per-axis rectangular integration (Appendix A); it is an angle only
@@ -157,7 +159,9 @@ def drift_slope(
 
 
 class DriftCorrection(NamedTuple):
-    """``angle`` (N, 3) corrected integrated angle (°; a DataArray for labelled input),
+    """Result of :func:`correct_drift`.
+
+    ``angle`` (N, 3) corrected integrated angle (°; a DataArray for labelled input),
     ``slope`` (3,) removed rate (°/s), ``method``.
     """
 
@@ -179,12 +183,9 @@ def correct_drift(
 
     Parameters
     ----------
-    gyr : Recording, DataArray or array_like (N, 3)
-        Angular velocity (a Recording's ``gyr``); labelled input carries its units, a
-        plain array is in ``units`` (default °/s).
-    fs : float, optional
-        Sampling rate (Hz); read from the attrs of labelled input, mandatory for a
-        plain array.
+    gyr, fs
+        Angular velocity and sampling rate (Hz), read as by :func:`integrate_rate`,
+        which integrates them.
     method : {"first_window", "linear_fit", "prior", "none"}
         See the module docstring.
     window_s : float
@@ -192,7 +193,12 @@ def correct_drift(
     prior_deg_s : array_like (3,)
         Drift rate (°/s) from an earlier calibration, for ``"prior"``.
     units : str, optional
-        Units of a plain-array ``gyr`` (``"deg/s"`` if not given).
+        Units of a plain-array ``gyr`` (default °/s), as in :func:`integrate_rate`.
+
+    Returns
+    -------
+    DriftCorrection
+        The corrected integrated angle (°), the removed slope (°/s) and the method.
     """
     s, _ = read_in(gyr, "gyr", "deg/s", fs=fs, units=units)
     g, fs = s.values, s.fs
@@ -290,7 +296,9 @@ def allan_deviation(
 
 
 class AllanNoise(NamedTuple):
-    """``arw`` angle random walk (rate unit·√s, e.g. °/√s — equal to the white-noise
+    """Noise parameters read off an Allan deviation curve.
+
+    ``arw`` angle random walk (rate unit·√s, e.g. °/√s — equal to the white-noise
     density in °/s/√Hz), ``bias_instability`` (rate unit), ``tau_min`` (s, where the
     deviation is smallest), ``rrw`` rate random walk (rate unit/√s, NaN if no +1/2 slope).
     """

@@ -1,4 +1,6 @@
-r"""Magnetometer calibration: Benhamou's four-point procedure, per-axis min/max, and an
+r"""Magnetometer calibration: four-point, per-axis min/max and ellipsoid fits.
+
+Magnetometer calibration: Benhamou's four-point procedure, per-axis min/max, and an
 ellipsoid (hard- and soft-iron) fit.
 
 A magnetometer reads :math:`r = W m + h + n`: the local field :math:`m` (sensor frame)
@@ -78,7 +80,9 @@ def four_point_poses(
 def four_point_mag_calibration(
     bottom, flank, flank_on: Literal["left", "right"] = "left"
 ) -> tuple[np.ndarray, np.ndarray]:
-    r"""Benhamou's four-point magnetometer calibration (Eq. 4): hard-iron offset and
+    r"""Calibrate a magnetometer by Benhamou's four-point procedure (Eq. 4).
+
+    Benhamou's four-point magnetometer calibration (Eq. 4): hard-iron offset and
     diagonal scale matrix.
 
     Parameters
@@ -135,6 +139,13 @@ def minmax_mag_calibration(mag) -> tuple[np.ndarray, np.ndarray]:
     mag : Recording, DataArray or array_like (N, 3)
         Raw readings (a Recording's ``mag``) covering, for every axis, both the
         northward and southward extremes.
+
+    Returns
+    -------
+    offset : numpy.ndarray, shape (3,)
+        Hard-iron offset ``(max + min) / 2`` (units of ``mag``).
+    matrix : numpy.ndarray, shape (3, 3)
+        Diagonal scale matrix ``diag(2 / (max - min))``.
     """
     r = _v.signal(mag, "mag", need_fs=False).values
     lo, hi = r.min(axis=0), r.max(axis=0)
@@ -161,6 +172,12 @@ def fit_mag_ellipsoid(
         for heading).
     max_condition : float
         Largest accepted condition number (see :func:`fit_ellipsoid`).
+
+    Returns
+    -------
+    EllipsoidFit
+        Hard iron ``offset`` and soft-iron correction ``matrix`` (symmetric), with
+        their standard errors and residuals (see :func:`fit_ellipsoid`).
     """
     r = _v.signal(mag, "mag", need_fs=False).values
     if field is None:

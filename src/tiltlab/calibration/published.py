@@ -38,75 +38,38 @@ __all__ = [
 ]
 
 
-def _table(number: int, date: str, rows: list[tuple]) -> pd.DataFrame:
-    df = pd.DataFrame(
-        rows,
-        columns=[
-            "device",
-            "axis",
-            "position_deg",
-            "iterations",
-            "mean_deg_s",
-            "sd_deg_s",
-        ],
-    )
-    return df.assign(table=number, date=date, duration_s=30.0)[
-        [
-            "table",
-            "date",
-            "device",
-            "axis",
-            "position_deg",
-            "duration_s",
-            "iterations",
-            "mean_deg_s",
-            "sd_deg_s",
-        ]
+def _tables(tables: dict[tuple[int, str], list[tuple]]) -> pd.DataFrame:
+    # one row per table, date, device, axis and position; each table (number, date)
+    # lists runs (device, position, iterations, x/y/z means, x/y/z SDs)
+    rows = [
+        (table, date, device, axis, position, 30.0, iterations, mean, sd)
+        for (table, date), runs in tables.items()
+        for device, position, iterations, means, sds in runs
+        for axis, mean, sd in zip("xyz", means, sds)
     ]
+    columns = ["table", "date", "device", "axis", "position_deg", "duration_s"]
+    return pd.DataFrame(
+        rows, columns=[*columns, "iterations", "mean_deg_s", "sd_deg_s"]
+    )
 
 
 #: Tables 2 and 3: mean ± SD drift rate (°/s) of 30-s static runs, one row per date,
 #: device, axis and position (24 rows).
-LACANNA_TABLES = pd.concat(
-    [
-        _table(
-            2,
-            "2018-02-22",
-            [
-                (1, "x", 0, 9, 0.29266, 0.00258),
-                (1, "y", 0, 9, -0.94509, 0.00577),
-                (1, "z", 0, 9, 0.82520, 0.00225),
-                (1, "x", 90, 10, 0.32767, 0.00658),
-                (1, "y", 90, 10, -0.92189, 0.00831),
-                (1, "z", 90, 10, 0.82041, 0.00335),
-                (2, "x", 0, 10, -0.17152, 0.00761),
-                (2, "y", 0, 10, -0.24403, 0.00798),
-                (2, "z", 0, 10, 0.56894, 0.00460),
-                (2, "x", 90, 10, -0.17172, 0.00708),
-                (2, "y", 90, 10, -0.26093, 0.00356),
-                (2, "z", 90, 10, 0.57133, 0.00262),
-            ],
-        ),
-        _table(
-            3,
-            "2018-03-08",
-            [
-                (1, "x", 0, 10, 0.29473, 0.00268),
-                (1, "y", 0, 10, -0.93504, 0.00562),
-                (1, "z", 0, 10, 0.77847, 0.00451),
-                (1, "x", 90, 10, 0.29408, 0.00220),
-                (1, "y", 90, 10, -0.95385, 0.00846),
-                (1, "z", 90, 10, 0.77228, 0.00145),
-                (2, "x", 0, 10, -0.14406, 0.00819),
-                (2, "y", 0, 10, -0.26186, 0.003021),
-                (2, "z", 0, 10, 0.56432, 0.00592),
-                (2, "x", 90, 10, -0.14223, 0.00270),
-                (2, "y", 90, 10, -0.28351, 0.00357),
-                (2, "z", 90, 10, 0.56147, 0.00382),
-            ],
-        ),
-    ],
-    ignore_index=True,
+LACANNA_TABLES = _tables(
+    {
+        (2, "2018-02-22"): [
+            (1, 0, 9, (0.29266, -0.94509, 0.82520), (0.00258, 0.00577, 0.00225)),
+            (1, 90, 10, (0.32767, -0.92189, 0.82041), (0.00658, 0.00831, 0.00335)),
+            (2, 0, 10, (-0.17152, -0.24403, 0.56894), (0.00761, 0.00798, 0.00460)),
+            (2, 90, 10, (-0.17172, -0.26093, 0.57133), (0.00708, 0.00356, 0.00262)),
+        ],
+        (3, "2018-03-08"): [
+            (1, 0, 10, (0.29473, -0.93504, 0.77847), (0.00268, 0.00562, 0.00451)),
+            (1, 90, 10, (0.29408, -0.95385, 0.77228), (0.00220, 0.00846, 0.00145)),
+            (2, 0, 10, (-0.14406, -0.26186, 0.56432), (0.00819, 0.003021, 0.00592)),
+            (2, 90, 10, (-0.14223, -0.28351, 0.56147), (0.00270, 0.00357, 0.00382)),
+        ],
+    }
 )
 
 #: Table 4: integrated angle (°) after ``final_time_s`` of one static device, per axis:

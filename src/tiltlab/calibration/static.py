@@ -29,6 +29,7 @@ References
 from __future__ import annotations
 
 import warnings
+from dataclasses import dataclass, replace
 from typing import NamedTuple
 
 import numpy as np
@@ -36,10 +37,11 @@ import xarray as xr
 
 from .. import _validate as _v
 from .. import units as _units
+from .._deprecate import renamed
 from ..dsp import still_mask
 from ..intervals import intervals_to_mask, mask_to_intervals
 from ..quality import QualityWarning
-from ._util import CalibrationError, read_in, vec3
+from ._util import CalibrationError, read_in, vec3, window_count
 
 __all__ = [
     "mask_to_intervals",
@@ -47,6 +49,7 @@ __all__ = [
     "static_intervals_from_trigger",
     "robust_gyro_offset",
     "detect_static",
+    "StillCriteria",
     "StaticStats",
     "static_means",
     "gyro_offset",
@@ -199,13 +202,9 @@ def robust_gyro_offset(
     if on_rotation not in ("warn", "raise"):
         raise ValueError(f"on_rotation must be 'warn' or 'raise', got {on_rotation!r}")
     g = s.values
-    w = max(int(round(window_s * s.fs)), 2)
-    nw = g.shape[0] // w
-    if nw < 1:
-        raise CalibrationError(
-            f"the recording ({g.shape[0]} samples) is shorter than one window of "
-            f"window_s = {window_s:g} s: cannot estimate a gyro offset"
-        )
+    w, nw = window_count(
+        g.shape[0], window_s, s.fs, 2, ("recording", ": cannot estimate a gyro offset")
+    )
     blocks = g[: nw * w].reshape(nw, w, 3)
     var = blocks.var(axis=1).sum(axis=1)  # NaN for a window that holds a gap
     ok = np.isfinite(var)
@@ -235,6 +234,65 @@ def robust_gyro_offset(
     return offset
 
 
+@dataclass(frozen=True)
+class StillCriteria:
+    """Settings of the threshold still-period detector of :func:`detect_static`.
+
+    The values are checked when :func:`detect_static` uses them.
+
+    Parameters
+    ----------
+    threshold_deg_s : float
+        Angular-speed threshold (°/s) on the offset-corrected, smoothed norm.
+    smooth_s : float
+        Width (s) of the moving average applied to the angular speed.
+    min_duration_s : float
+        Shortest still period kept (s).
+    merge_gap_s : float
+        Still runs separated by less than this (s) are merged.
+    trim_s : float, optional
+        Duration (s) trimmed at both ends of each run; default half of ``smooth_s``.
+    acc_std_threshold_g : float, optional
+        Largest moving standard deviation of ‖a‖ (g) at rest; ``None`` disables the
+        acceleration criterion.
+    """
+
+    threshold_deg_s: float = 3.0
+    smooth_s: float = 0.1
+    min_duration_s: float = 0.4
+    merge_gap_s: float = 0.0
+    trim_s: float | None = None
+    acc_std_threshold_g: float | None = None
+
+
+def _criteria(criteria: StillCriteria | None, options: dict) -> StillCriteria:
+    # the criteria record with keyword overrides (detect_static's **options)
+    crit = StillCriteria() if criteria is None else criteria
+    if not isinstance(crit, StillCriteria):
+        raise TypeError(f"criteria must be a StillCriteria, got {type(crit).__name__}")
+    unknown = sorted(set(options) - set(StillCriteria.__dataclass_fields__))
+    if unknown:
+        raise TypeError(
+            f"detect_static() got unexpected keyword argument(s) {', '.join(unknown)}"
+        )
+    return replace(crit, **options)
+
+
+def _acc_norm(acc, gyr, fs, shape) -> np.ndarray:
+    # ‖a‖ (g) for the acceleration criterion; a Recording ``gyr`` lends its ``acc``
+    if acc is None and isinstance(gyr, xr.Dataset):
+        acc = gyr
+    if acc is None:
+        raise ValueError("acc_std_threshold_g needs acc (the acceleration)")
+    a, _ = read_in(acc, "acc", "g", fs=fs, need_fs=False)
+    if a.values.shape != shape:
+        raise ValueError(
+            f"acc and gyr must have the same shape, got {a.values.shape} and {shape}"
+        )
+    return np.linalg.norm(a.values, axis=1)
+
+
+@renamed(offset="gyr_offset")
 def detect_static(
     gyr,
     fs: float | None = None,
@@ -242,27 +300,24 @@ def detect_static(
     units: str | None = None,
     acc=None,
     trigger=None,
-    threshold_deg_s: float = 3.0,
-    smooth_s: float = 0.1,
-    min_duration_s: float = 0.4,
-    merge_gap_s: float = 0.0,
-    trim_s: float | None = None,
-    acc_std_threshold_g: float | None = None,
-    offset=None,
+    gyr_offset=None,
     trigger_window_s: float = 0.4,
+    criteria: StillCriteria | None = None,
+    **options,
 ) -> np.ndarray:
-    r"""Still periods of a calibration recording.
+    r"""Find the still periods of a calibration recording.
 
     With a ``trigger`` channel, the ``trigger_window_s`` before each rising edge
     (:func:`static_intervals_from_trigger`). Otherwise: (1) convert the gyroscope to
-    °/s and subtract a first-pass offset (``offset`` or :func:`robust_gyro_offset`);
+    °/s and subtract a first-pass offset (``gyr_offset`` or :func:`robust_gyro_offset`);
     (2)–(5) the still-period detector :func:`tiltlab.dsp.still_mask` on the angular
     speed :math:`\|\omega - o\|`: smoothing by a ``smooth_s`` moving average, samples
     below ``threshold_deg_s`` (and, if ``acc_std_threshold_g`` is given, whose moving
     standard deviation of :math:`\|a\|` is below it), merging of runs separated by
     less than ``merge_gap_s``, trimming of ``trim_s`` at both ends of each run (default
     half the smoothing window, which the moving average spreads into the movement),
-    removal of runs shorter than ``min_duration_s``.
+    removal of runs shorter than ``min_duration_s``. These settings are the fields of
+    :class:`StillCriteria`; pass a record as ``criteria``, or any field as a keyword.
 
     Parameters
     ----------
@@ -281,23 +336,40 @@ def detect_static(
         g; plain: in g). Default: the Recording's ``acc`` when ``gyr`` is a Recording.
     trigger : DataArray or array_like (N,), optional
         Trigger channel; when given, thresholds are not used.
-    threshold_deg_s : float
-        Angular-speed threshold (°/s) on the offset-corrected, smoothed norm.
-    smooth_s, min_duration_s, merge_gap_s, trim_s : float
-        Durations in seconds.
-    acc_std_threshold_g : float, optional
-        Largest moving standard deviation of ‖a‖ (g) at rest.
-    offset : array_like (3,), optional
-        Gyro offset, in the units of ``gyr``, to subtract instead of the robust first
-        pass.
+    gyr_offset : array_like (3,), optional
+        Gyroscope offset, in the units of ``gyr``, to subtract instead of the robust
+        first pass (formerly ``offset``, which still works with a ``FutureWarning``).
     trigger_window_s : float
         Duration of each trigger-defined still period (s).
+    criteria : StillCriteria, optional
+        Detector settings (default ``StillCriteria()``: 3 °/s, 0.1-s smoothing,
+        periods of at least 0.4 s).
+    **options
+        Fields of :class:`StillCriteria` (``threshold_deg_s``, ``smooth_s``,
+        ``min_duration_s``, ``merge_gap_s``, ``trim_s``, ``acc_std_threshold_g``)
+        overriding those of ``criteria``.
 
     Returns
     -------
     ndarray (P, 2)
         ``[start, stop)`` sample indices of the still periods.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from tiltlab import calibration
+    >>> rng = np.random.default_rng(0)
+    >>> gyr = rng.normal(0.0, 0.2, (500, 3)) + [5.0, -2.0, 1.0]  # offset, °/s
+    >>> gyr[200:300, 2] += 90.0 * np.sin(np.linspace(0.0, np.pi, 100))  # one turn
+    >>> calibration.detect_static(gyr, 100.0).tolist()
+    [[5, 195], [306, 495]]
+
+    Without the first-pass offset, the 5.5 °/s offset hides every still sample:
+
+    >>> calibration.detect_static(gyr, 100.0, gyr_offset=[0.0, 0.0, 0.0]).tolist()
+    []
     """
+    crit = _criteria(criteria, options)
     s, factor = read_in(gyr, "gyr", "deg/s", fs=fs, units=units)
     g, fs = s.values, s.fs
     if trigger is not None:
@@ -307,41 +379,37 @@ def detect_static(
                 f"trigger must have shape ({g.shape[0]},), got {tr.values.shape}"
             )
         return static_intervals_from_trigger(tr.values, fs, window_s=trigger_window_s)
-    smooth_s = _v.nonnegative(smooth_s, "smooth_s")
-    trim_s = 0.5 * smooth_s if trim_s is None else _v.nonnegative(trim_s, "trim_s")
-    if offset is None:
+    smooth_s = _v.nonnegative(crit.smooth_s, "smooth_s")
+    trim_s = (
+        0.5 * smooth_s if crit.trim_s is None else _v.nonnegative(crit.trim_s, "trim_s")
+    )
+    if gyr_offset is None:
         o = robust_gyro_offset(g, fs)
     else:
-        o = vec3(offset, "offset", ndim=1) * factor
+        o = vec3(gyr_offset, "gyr_offset", ndim=1) * factor
+    acc_std = crit.acc_std_threshold_g
     acc_norm = None
-    if acc_std_threshold_g is not None:
-        acc_std_threshold_g = _v.positive(acc_std_threshold_g, "acc_std_threshold_g")
-        if acc is None and isinstance(gyr, xr.Dataset):
-            acc = gyr
-        if acc is None:
-            raise ValueError("acc_std_threshold_g needs acc (the acceleration)")
-        a, _ = read_in(acc, "acc", "g", fs=fs, need_fs=False)
-        if a.values.shape != g.shape:
-            raise ValueError(
-                f"acc and gyr must have the same shape, got {a.values.shape} and {g.shape}"
-            )
-        acc_norm = np.linalg.norm(a.values, axis=1)
+    if acc_std is not None:
+        acc_std = _v.positive(acc_std, "acc_std_threshold_g")
+        acc_norm = _acc_norm(acc, gyr, fs, g.shape)
     mask = still_mask(
         np.linalg.norm(g - o, axis=1),
         fs,
-        threshold=_v.positive(threshold_deg_s, "threshold_deg_s"),
+        threshold=_v.positive(crit.threshold_deg_s, "threshold_deg_s"),
         smooth_s=smooth_s,
         acc_norm=acc_norm,
-        acc_std_threshold=acc_std_threshold_g,
-        merge_gap_s=merge_gap_s,
-        min_duration_s=min_duration_s,
+        acc_std_threshold=acc_std,
+        merge_gap_s=crit.merge_gap_s,
+        min_duration_s=crit.min_duration_s,
         trim_s=trim_s,
     )
     return mask_to_intervals(mask)
 
 
 class StaticStats(NamedTuple):
-    """Per-period statistics: ``mean`` (P, 3), ``sem`` (P, 3) standard error of the mean,
+    """Statistics of each still period (result of :func:`static_means`).
+
+    Per-period statistics: ``mean`` (P, 3), ``sem`` (P, 3) standard error of the mean,
     ``std`` (P, 3) and ``n`` (P,) sample counts.
     """
 
@@ -375,6 +443,11 @@ def static_means(
         would bias any fit).
     min_periods : int
         Minimum number of periods required.
+
+    Returns
+    -------
+    StaticStats
+        Per-period ``mean``, ``sem``, ``std`` (P, 3) and sample counts ``n`` (P,).
 
     Notes
     -----

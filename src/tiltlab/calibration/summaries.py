@@ -1,5 +1,7 @@
-"""Summaries of a calibration: how far a recording's acceleration norm is from 1 g,
-and the Allan-deviation noise terms read off a curve set against simulated truth.
+"""Summaries of a calibration: acceleration norm error and Allan noise terms.
+
+How far a recording's acceleration norm is from 1 g, and the Allan-deviation noise
+terms read off a curve set against simulated truth.
 
 Both are the numbers chapter 3 reports; they compute, the chapter narrates.
 """
@@ -9,8 +11,9 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from .drift import AllanNoise
+from .._labels import label_columns
 from ._util import read_in
+from .drift import AllanNoise
 
 __all__ = ["recording_norm_error", "allan_noise_table"]
 
@@ -23,9 +26,9 @@ ALLAN_ROWS = {
 
 
 def recording_norm_error(data, *, units: str | None = None) -> np.ndarray:
-    """Distance of the acceleration norm from 1 g, per sample.
+    r"""Distance of the acceleration norm from 1 g, per sample.
 
-    At rest an accelerometer measures gravity alone, so :math:`|1 - \\|\\mathbf a\\||`
+    At rest an accelerometer measures gravity alone, so :math:`|1 - \|\mathbf a\||`
     (in g) is the calibration error left in each still sample.
 
     Parameters
@@ -39,7 +42,7 @@ def recording_norm_error(data, *, units: str | None = None) -> np.ndarray:
     Returns
     -------
     numpy.ndarray (n,)
-        :math:`|1 - \\|\\mathbf a\\||` in g; NaN where a sample is NaN.
+        :math:`|1 - \|\mathbf a\||` in g; NaN where a sample is NaN.
 
     Examples
     --------
@@ -73,7 +76,7 @@ def allan_noise_table(
     *,
     rtol: float = 0.1,
 ) -> pd.DataFrame:
-    """The noise terms read off an Allan deviation curve, against their true values.
+    """Tabulate the noise terms read off an Allan deviation curve, against their truth.
 
     Parameters
     ----------
@@ -93,7 +96,8 @@ def allan_noise_table(
         true value, or ``"none"``), ``"read off the curve (x, y, z)"`` (two
         significant digits per axis, ``"not found"`` where the curve has no such
         slope) and ``"recovered"`` (``"yes"``, ``"no"``, or ``"no (spurious)"`` for
-        an absent term found anyway); the first and last only with ``truth``.
+        an absent term found anyway); the first and last only with ``truth``. Text
+        columns, labelled (``attrs["long_name"]``; each row's units are in its label).
 
     Examples
     --------
@@ -110,12 +114,12 @@ def allan_noise_table(
     terms = list(ALLAN_ROWS)
     read = {"read off the curve (x, y, z)": [_fmt(getattr(noise, k)) for k in terms]}
     if truth is None:
-        return pd.DataFrame(read, index=list(ALLAN_ROWS.values()))
+        return _label_allan(pd.DataFrame(read, index=list(ALLAN_ROWS.values())))
     unknown = set(truth) - set(terms)
     if unknown:
         raise ValueError(f"truth has unknown terms {sorted(unknown)}; use {terms}")
     true = [truth.get(k) for k in terms]
-    return pd.DataFrame(
+    table = pd.DataFrame(
         {
             "simulated": ["none" if t is None else f"{t:.2g}" for t in true],
             **read,
@@ -125,4 +129,19 @@ def allan_noise_table(
             ],
         },
         index=list(ALLAN_ROWS.values()),
+    )
+    return _label_allan(table)
+
+
+def _label_allan(table: pd.DataFrame) -> pd.DataFrame:
+    """Label the Allan table's columns (text: the units are in the row labels)."""
+    names = {
+        "simulated": "true value (simulation)",
+        "read off the curve (x, y, z)": "read off the Allan deviation (x, y, z)",
+        "recovered": "recovered within the tolerance",
+    }
+    return label_columns(
+        table,
+        units=dict.fromkeys(table.columns, ""),
+        long_name={c: names[c] for c in table.columns},
     )

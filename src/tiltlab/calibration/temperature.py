@@ -20,7 +20,7 @@ import xarray as xr
 
 from .. import _validate as _v
 from .. import units as _units
-from ._util import CalibrationError, read_temp_degc, vec3
+from ._util import CalibrationError, read_temp_degc, vec3, window_count
 
 __all__ = [
     "TemperatureModel",
@@ -32,7 +32,7 @@ __all__ = [
 
 @dataclass(frozen=True)
 class TemperatureModel:
-    """Per-axis polynomial offsets :math:`o_i(T) = \\sum_k c_{ik}(T - T_0)^k`.
+    r"""Per-axis polynomial offsets :math:`o_i(T) = \sum_k c_{ik}(T - T_0)^k`.
 
     Attributes
     ----------
@@ -77,6 +77,7 @@ class TemperatureModel:
         return np.stack([np.polyval(np.asarray(c), x) for c in self.coef], axis=-1)
 
     def to_dict(self) -> dict:
+        """Return the model as a JSON-serialisable dict."""
         return {
             "coef": [list(map(float, c)) for c in self.coef],
             "t0": float(self.t0),
@@ -86,6 +87,7 @@ class TemperatureModel:
 
     @classmethod
     def from_dict(cls, d: dict) -> "TemperatureModel":
+        """Rebuild a model from :meth:`to_dict` output."""
         return cls(
             tuple(tuple(c) for c in d["coef"]),
             float(d["t0"]),
@@ -110,6 +112,11 @@ def fit_temperature_model(
         temperatures (one spare degree of freedom).
     units : str
         Units of the offsets.
+
+    Returns
+    -------
+    TemperatureModel
+        Per-axis polynomial coefficients, reference temperature and fitted range.
     """
     o = vec3(offsets, "offsets", ndim=2)
     t = read_temp_degc(temp, o.shape[0])
@@ -136,6 +143,7 @@ def compensate_temperature(x, temp, model: TemperatureModel):
     temp : DataArray or array_like (N,)
         Sensor temperature (°C; or a labelled one in K).
     model : TemperatureModel
+        Offsets versus temperature (:func:`fit_temperature_model`).
 
     Returns
     -------
@@ -191,12 +199,6 @@ def offsets_vs_temperature(
         temp = x["temp"]
     t = read_temp_degc(temp, a.shape[0])
     window_s = _v.positive(window_s, "window_s")
-    w = max(int(round(window_s * s.fs)), 1)
-    k = a.shape[0] // w
-    if k < 1:
-        raise CalibrationError(
-            f"the record ({a.shape[0]} samples) is shorter than one window of "
-            f"window_s = {window_s:g} s"
-        )
+    w, k = window_count(a.shape[0], window_s, s.fs, 1, ("record", ""))
     temps = t[: k * w].reshape(k, w).mean(axis=1)
     return temps, np.median(a[: k * w].reshape(k, w, 3), axis=1)

@@ -65,46 +65,20 @@ from .cohort import (
     simulate_cohort,
 )
 from .track import Track, simulate_heave, simulate_track
+import tiltlab.simulate.cohort as _cohort
+import tiltlab.simulate.export as _export
+import tiltlab.simulate.kinematics as _kinematics
+import tiltlab.simulate.mocap as _mocap
+import tiltlab.simulate.sensor as _sensor
+import tiltlab.simulate.track as _track
+import tiltlab.simulate.tumble as _tumble
 
 __all__ = [
-    "STATES",
-    "BehaviourParams",
-    "Lesion",
-    "TrueMotion",
-    "behaviour_bouts",
-    "head_kinematics",
-    "target_tilt",
-    "ACC_OFFSET_RANGE_G",
-    "GYR_OFFSET_RANGE_DPS",
-    "SensorModel",
-    "apply_sensor_model",
-    "draw_sensor",
-    "magnetometer_readings",
-    "recording_from_motion",
-    "simulate_session",
-    "true_sensor_values",
-    "stage_angles",
-    "stage_quaternion",
-    "tumble_test",
-    "zoh_angular_velocity",
-    "PHONE_FILES",
-    "phone_export",
-    "MarkerSupport",
-    "head_frame_from_markers",
-    "mocap_markers",
-    "simulate_mocap_session",
-    "ANAESTHESIA",
-    "EFFECTS",
-    "FAYAT_GROUPS",
-    "HOURS",
-    "TIME_POINTS",
-    "Cohort",
-    "CohortDesign",
-    "iter_sessions",
-    "load_cohort",
-    "session_plan",
-    "simulate_cohort",
-    "Track",
-    "simulate_track",
-    "simulate_heave",
+    *_kinematics.__all__,
+    *_sensor.__all__,
+    *_tumble.__all__,
+    *_export.__all__,
+    *_mocap.__all__,
+    *_cohort.__all__,
+    *_track.__all__,
 ]

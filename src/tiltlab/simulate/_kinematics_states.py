@@ -1,16 +1,9 @@
-r"""Behaviour parameters of the head-kinematics generator: the lesion, the generator's
-parameters and the tilt of a posture (private part of :mod:`tiltlab.simulate.kinematics`).
+r"""Behaviour parameters of the head-kinematics generator (private part of its module).
 
-Everything here is re-exported by :mod:`tiltlab.simulate.kinematics` (and
-:mod:`tiltlab.simulate`), where it is documented and imported from; this module imports
-nothing from it (the dependency runs one way).
-
-References
-----------
-.. [1] R. Fayat, V. Delgado Betancourt, T. Goyallon, M. Petremann, P. Liaudet,
-   V. Descossy, L. Reveret, G. P. Dugué, "Inertial measurement of head tilt in
-   rodents: principles and applications to vestibular research", Sensors 21(18):6318,
-   2021. doi:10.3390/s21186318
+The lesion, the generator's parameters and the tilt of a posture. Everything here is
+re-exported by :mod:`tiltlab.simulate.kinematics` (and :mod:`tiltlab.simulate`), where
+it is documented (with its references) and imported from; this module imports nothing
+from it (the dependency runs one way).
 """
 
 from __future__ import annotations
@@ -72,8 +65,8 @@ class BehaviourParams:
     Angles in degrees, durations in seconds, lengths in metres (names say so).
     Defaults give a healthy rat exploring a small box in the dark, tuned so that the
     angular-speed distribution is bimodal, with a still mode near 4–5 °/s, a moving mode
-    near 80–120 °/s and a valley at 10–13 °/s (the 12 °/s threshold of Fayat et al. [1]_,
-    Fig. A3; checked over 30 seeds of 10-min sessions).
+    near 80–120 °/s and a valley at 10–13 °/s (the 12 °/s threshold of Fayat et al.
+    2021, doi:10.3390/s21186318, Fig. A3; checked over 30 seeds of 10-min sessions).
 
     Parameters
     ----------
@@ -165,7 +158,7 @@ class BehaviourParams:
             raise ValueError("baseline_pitch_deg must be within (-90, 90)")
 
     def with_lesion(self, lesion: Lesion | None) -> "BehaviourParams":
-        """These parameters with a :class:`Lesion` applied (``None`` returns ``self``).
+        """Apply a :class:`Lesion` to these parameters (``None`` returns ``self``).
 
         The roll is solved so that the baseline tilt point lies ``lesion.tilt_deg``
         from the sagittal plane on the lesion side.
@@ -197,13 +190,13 @@ class BehaviourParams:
         )
 
     def baseline_tilt(self) -> np.ndarray:
-        """The baseline tilt point ``g0`` (unit vector, sensor frame)."""
+        """Return the baseline tilt point ``g0`` (unit vector, sensor frame)."""
         return target_tilt(
             math.radians(self.baseline_pitch_deg), math.radians(self.baseline_roll_deg)
         )
 
     def to_dict(self) -> dict:
-        """JSON-serialisable dict of the parameters."""
+        """Return the parameters as a JSON-serialisable dict."""
         return {
             k: (list(v) if isinstance(v, tuple) else v) for k, v in asdict(self).items()
         }

@@ -99,6 +99,15 @@ ANAESTHESIA: dict[str, tuple[float, ...]] = {
     "mobility": (1.0, 0.85, 0.93, 1.0, 1.0, 1.0, 1.0),
 }
 
+# both sham groups: the transient effect of surgery and anaesthesia, no lesion
+_SHAM: dict[str, tuple[float, ...]] = {
+    "immobility": (0.0, 0.03, 0.02, 0.0, 0.0, 0.0, 0.0),
+    "mobility": (1.0, 0.95, 1.0, 1.0, 1.0, 1.0, 1.0),
+    "tilt_deg": (0.0,) * 7,
+    "pitch_deg": (0.0,) * 7,
+    "circling_cpm": (0.0,) * 7,
+}
+
 #: Lesion (or vehicle) effects per group and time point (TIME_POINTS order):
 #: ``immobility`` added fraction, ``mobility`` multiplier, ``tilt_deg`` toward the
 #: lesion side (angle of the baseline tilt point to the sagittal plane),
@@ -118,20 +127,8 @@ EFFECTS: dict[str, dict[str, tuple[float, ...]]] = {
         "pitch_deg": (0.0, 1.0, 5.0, 6.0, 8.0, 7.0, 6.0),
         "circling_cpm": (0.0, 0.0, 0.2, 0.5, 1.5, 2.0, 2.0),
     },
-    "ShamKainate": {
-        "immobility": (0.0, 0.03, 0.02, 0.0, 0.0, 0.0, 0.0),
-        "mobility": (1.0, 0.95, 1.0, 1.0, 1.0, 1.0, 1.0),
-        "tilt_deg": (0.0,) * 7,
-        "pitch_deg": (0.0,) * 7,
-        "circling_cpm": (0.0,) * 7,
-    },
-    "ShamArsanilate": {
-        "immobility": (0.0, 0.03, 0.02, 0.0, 0.0, 0.0, 0.0),
-        "mobility": (1.0, 0.95, 1.0, 1.0, 1.0, 1.0, 1.0),
-        "tilt_deg": (0.0,) * 7,
-        "pitch_deg": (0.0,) * 7,
-        "circling_cpm": (0.0,) * 7,
-    },
+    "ShamKainate": dict(_SHAM),
+    "ShamArsanilate": dict(_SHAM),
     "Healthy": {
         "immobility": (0.0,) * 7,
         "mobility": (1.0,) * 7,
@@ -185,6 +182,7 @@ class CohortDesign:
     session_tilt_sd: float = 2.0
 
     def __post_init__(self):
+        """Check that the tables match the time points and the lesion side is valid."""
         nt = len(self.time_points)
         if len(self.hours) != nt:
             raise ValueError("time_points and hours must have the same length")
@@ -217,7 +215,9 @@ class CohortDesign:
         return cls(groups={g: n_per_group for g in FAYAT_GROUPS}, **kwargs)
 
     def select(self, *, groups: dict | None = None, time_points=None) -> "CohortDesign":
-        """This design restricted to some time points (effect tables cut to match) and
+        """Restrict this design to some time points and change its group sizes.
+
+        This design restricted to some time points (effect tables cut to match) and
         with other group sizes (``groups``: name → number of animals, names from
         ``effects``).
         """
@@ -242,6 +242,7 @@ class CohortDesign:
         )
 
     def to_dict(self) -> dict:
+        """Return the design as a JSON-serialisable dict."""
         d = asdict(self)
         d["time_points"], d["hours"] = list(self.time_points), list(self.hours)
         return json.loads(json.dumps(d))
@@ -359,7 +360,7 @@ def session_plan(
 
 
 def _animal_sensor(row: dict) -> SensorModel:
-    """The animal's IMU: errors from the animal's seed; temperatures left to each recording."""
+    """Draw the animal's IMU: errors from the animal's seed; temperatures left to each recording."""
     sensor = draw_sensor(SensorModel(), np.random.default_rng(row["imu_seed"]))
     return SensorModel(**{**sensor.__dict__, "temp_start": None, "temp_end": None})
 
@@ -378,7 +379,7 @@ def _simulate_tumble(row: dict, out_dir: str) -> str:
 
 
 def _true_features(motion: TrueMotion, side_sign: float) -> dict:
-    """The features of :mod:`tiltlab.cohort` computed on the TRUE motion.
+    """Compute the features of :mod:`tiltlab.cohort` on the TRUE motion.
 
     Why this is the truth to recover: a feature such as "immobile fraction" is defined
     by a rule set applied to an angular speed (Fayat §2.9: < 12 °/s, gaps < 0.1 s
@@ -597,7 +598,9 @@ def simulate_cohort(
 
 @dataclass
 class Cohort:
-    """A cohort directory: ``sessions`` table, planted ``truth`` (None for real data),
+    """A cohort directory with its sessions, planted truth and design.
+
+    A cohort directory: ``sessions`` table, planted ``truth`` (None for real data),
     ``design`` metadata.
     """
 
@@ -607,6 +610,7 @@ class Cohort:
     design: dict
 
     def __len__(self) -> int:
+        """Return the number of sessions."""
         return len(self.sessions)
 
     def load(
@@ -631,7 +635,9 @@ class Cohort:
 
 
 def load_cohort(path) -> Cohort:
-    """Read a cohort directory (``sessions.csv`` with columns subject, group,
+    """Read a cohort directory.
+
+    Read a cohort directory (``sessions.csv`` with columns subject, group,
     timepoint, hours, file; optional ``truth.csv`` and ``design.json``).
 
     Parameters

@@ -1,5 +1,6 @@
-"""A Recording written the way a phone logging app exports it: one CSV per sensor, each on
-its own jittery clock with nanosecond epoch times (:func:`phone_export`).
+"""A Recording written the way a phone logging app exports it (:func:`phone_export`).
+
+One CSV per sensor, each on its own jittery clock with nanosecond epoch times.
 """
 
 from __future__ import annotations
@@ -13,6 +14,9 @@ import xarray as xr
 
 from .. import _validate as _v
 from .. import units as _units
+from .._deprecate import renamed
+
+__all__ = ["PHONE_FILES", "phone_export"]
 
 #: file name, the phone's unit and the variable's name in a phone export
 PHONE_FILES = {
@@ -23,9 +27,10 @@ PHONE_FILES = {
 
 
 def _stream_times(t0: float, t1: float, fs: float, rng, drift: float, jitter: float):
-    """Sample times of one stream in [t0, t1]: its own rate (``fs`` off by up to
-    ``drift``), its own start within the first period, and Gaussian jitter of
-    ``jitter`` periods (kept increasing).
+    """Draw the sample times of one stream in [t0, t1].
+
+    The stream has its own rate (``fs`` off by up to ``drift``), its own start within
+    the first period, and Gaussian jitter of ``jitter`` periods (kept increasing).
     """
     rate = fs * (1.0 + rng.uniform(-drift, drift))
     start = t0 + rng.uniform(0.0, 1.0 / rate)
@@ -36,8 +41,9 @@ def _stream_times(t0: float, t1: float, fs: float, rng, drift: float, jitter: fl
     return t[keep], rate
 
 
+@renamed(recording="rec")
 def phone_export(
-    recording: xr.Dataset,
+    rec: xr.Dataset,
     folder: str | PathLike,
     *,
     drift: float = 0.01,
@@ -60,8 +66,9 @@ def phone_export(
 
     Parameters
     ----------
-    recording : xarray.Dataset
-        A Recording; ``acc`` and whichever of ``gyr`` and ``mag`` it has are written.
+    rec : xarray.Dataset
+        A Recording; ``acc`` and whichever of ``gyr`` and ``mag`` it has are written
+        (formerly ``recording``, which still works with a ``FutureWarning``).
     folder : path-like
         Folder to write into (created if needed).
     drift : float
@@ -87,11 +94,11 @@ def phone_export(
     >>> sorted(p.name for p in files.values())
     ['Gyroscope.csv', 'TotalAcceleration.csv']
     """
-    if not isinstance(recording, xr.Dataset) or "acc" not in recording:
+    if not isinstance(rec, xr.Dataset) or "acc" not in rec:
         raise _v.RecordingError("phone_export needs a Recording with acc")
-    if recording.attrs.get("fs") is None:
+    if rec.attrs.get("fs") is None:
         raise _v.RecordingError("phone_export: the Recording has no fs attribute")
-    fs = _v.check_fs(recording.attrs["fs"])
+    fs = _v.check_fs(rec.attrs["fs"])
     if not 0.0 <= drift < 0.5 or not 0.0 <= jitter < 0.5:
         raise ValueError(
             f"drift must be in [0, 0.5) and jitter in [0, 0.5) periods, got "
@@ -100,15 +107,13 @@ def phone_export(
     out = Path(folder)
     out.mkdir(parents=True, exist_ok=True)
     rng = np.random.default_rng(seed)
-    t = recording["time"].values.astype(float)
+    t = rec["time"].values.astype(float)
     t0, t1 = float(t[0]), float(t[-1])
     files = {}
     for var, (name, unit) in PHONE_FILES.items():
-        if var not in recording:
+        if var not in rec:
             continue
-        values = _units.convert(
-            recording[var].values, recording[var].attrs["units"], unit
-        )
+        values = _units.convert(rec[var].values, rec[var].attrs["units"], unit)
         times, _ = _stream_times(t0, t1, fs, rng, drift, jitter)
         table = pd.DataFrame(
             {

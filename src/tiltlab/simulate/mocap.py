@@ -46,7 +46,9 @@ __all__ = [
 
 @dataclass(frozen=True)
 class MarkerSupport:
-    """Rigid marker support. ``markers_mm``: nominal marker positions in the head
+    """Rigid marker support of a motion-capture session.
+
+    Rigid marker support. ``markers_mm``: nominal marker positions in the head
     (= sensor) frame, mm, rows = markers 1..4; ``misalign_deg``: standard deviation of
     the random rotation between the marker frame and the IMU axes.
     """
@@ -60,6 +62,7 @@ class MarkerSupport:
     misalign_deg: float = 2.0
 
     def __post_init__(self):
+        """Check the marker layout."""
         m = np.asarray(self.markers_mm, float)
         if m.ndim != 2 or m.shape[1] != 3 or m.shape[0] < 3:
             raise ValueError(f"markers_mm must be (M >= 3, 3), got {m.shape}")
@@ -92,7 +95,9 @@ def mocap_markers(
     motion : TrueMotion
         True head motion (``q``, ``pos``) at the IMU rate ``motion.fs``.
     rng : numpy.random.Generator
+        Random source of the support misalignment, noise, occlusions and clock.
     support : MarkerSupport, optional
+        Marker layout (default ``MarkerSupport()``).
     noise_mm : float
         Per-coordinate Gaussian noise (mm).
     occlusion_rate, reflection_rate : float
@@ -221,7 +226,9 @@ def simulate_mocap_session(
     support: MarkerSupport | None = None,
     **mocap_kwargs,
 ) -> tuple[xr.Dataset, xr.Dataset]:
-    """A concurrent IMU + motion-capture session (Fayat §2.6): returns the IMU
+    """Simulate a concurrent IMU + motion-capture session (Fayat §2.6).
+
+    A concurrent IMU + motion-capture session (Fayat §2.6): returns the IMU
     Recording (with a boolean ``sync`` variable marking TTL-bearing samples) and the
     mocap Dataset of :func:`mocap_markers`.
 

@@ -32,14 +32,15 @@ from __future__ import annotations
 
 import math
 from dataclasses import asdict, dataclass, replace
+from typing import NamedTuple
 
 import numpy as np
 import xarray as xr
-from numba import njit
 
 from .. import quaternion as _quat
 from .. import schema as _schema
 from ..units import G0
+from ._sensor_kernel import measure_kernel
 from .kinematics import STATES, BehaviourParams, Lesion, TrueMotion, head_kinematics
 
 __all__ = [
@@ -136,6 +137,7 @@ class SensorModel:
     mag_noise_uT: float = 0.6
 
     def __post_init__(self):
+        """Check the noise levels, ranges and the shapes of the given errors."""
         for k in (
             "acc_noise_density",
             "gyr_noise_density",
@@ -162,8 +164,10 @@ class SensorModel:
 
     @classmethod
     def ideal(cls, *, magnetometer: bool = False) -> "SensorModel":
-        """A perfect sensor: no offset, scale, misalignment, noise, drift, temperature
-        effect, saturation or quantisation (measured = true).
+        """Build a perfect sensor (measured = true).
+
+        No offset, scale, misalignment, noise, drift, temperature effect, saturation or
+        quantisation.
         """
         z, e = (0.0, 0.0, 0.0), ((0.0,) * 3,) * 3
         return cls(
@@ -268,102 +272,44 @@ def draw_sensor(sensor: SensorModel | None, rng: np.random.Generator) -> SensorM
     )
 
 
-@njit(cache=True)
-def _measure_kernel(
-    x,
-    T,
-    offset,
-    temp_coef,
-    dtemp,
-    noise_sd,
-    walk_sd,
-    lo,
-    hi,
-    lsb,
-    quantize,
-    seed,
-    out,
-    bias_mean,
-):
-    # y = Q(sat(T x + o + c dT + b + n)); b a random walk started at 0
-    np.random.seed(seed)
-    n = x.shape[0]
-    b0 = 0.0
-    b1 = 0.0
-    b2 = 0.0
-    s0 = 0.0
-    s1 = 0.0
-    s2 = 0.0
-    n_sat = 0
-    for k in range(n):
-        x0, x1, x2 = x[k, 0], x[k, 1], x[k, 2]
-        for i in range(3):
-            v = (
-                T[i, 0] * x0
-                + T[i, 1] * x1
-                + T[i, 2] * x2
-                + offset[i]
-                + temp_coef[i] * dtemp[k]
-            )
-            if i == 0:
-                v += b0
-            elif i == 1:
-                v += b1
-            else:
-                v += b2
-            if noise_sd > 0.0:
-                v += noise_sd * np.random.standard_normal()
-            if v < lo:
-                v = lo
-                n_sat += 1
-            elif v > hi:
-                v = hi
-                n_sat += 1
-            if quantize:
-                v = np.round(v / lsb) * lsb
-            out[k, i] = v
-        s0 += b0
-        s1 += b1
-        s2 += b2
-        if walk_sd > 0.0:
-            b0 += walk_sd * np.random.standard_normal()
-            b1 += walk_sd * np.random.standard_normal()
-            b2 += walk_sd * np.random.standard_normal()
-    bias_mean[0] = s0 / n
-    bias_mean[1] = s1 / n
-    bias_mean[2] = s2 / n
-    return n_sat
+class _Triad(NamedTuple):
+    # the errors of one 3-axis sensor of a drawn SensorModel, in the kernel's terms
+    matrix: np.ndarray  # T = (I + diag(s)) (I + E)
+    offset: np.ndarray
+    temp_coef: np.ndarray
+    noise_sd: float
+    walk_sd: float
+    full_scale: float
 
 
-def _measure(
-    x,
-    scale,
-    misalign,
-    offset_ref,
-    temp_coef,
-    dtemp,
-    noise_sd,
-    walk_sd,
-    rng,
-    full_scale,
-    quantize,
-):
-    T = (np.eye(3) + np.diag(np.asarray(scale, float))) @ (
-        np.eye(3) + np.asarray(misalign, float)
+def _triad(s: SensorModel, name: str, fs: float) -> _Triad:
+    # the errors of s's accelerometer (name "acc") or gyroscope ("gyr") at rate fs
+    scale = np.asarray(getattr(s, f"{name}_scale"), float)
+    misalign = np.asarray(getattr(s, f"{name}_misalign"), float)
+    return _Triad(
+        (np.eye(3) + np.diag(scale)) @ (np.eye(3) + misalign),
+        np.asarray(getattr(s, f"{name}_offset"), float),
+        np.asarray(getattr(s, f"{name}_temp_coef"), float),
+        getattr(s, f"{name}_noise_density") * math.sqrt(fs / 2.0),
+        getattr(s, f"{name}_bias_walk") * math.sqrt(1.0 / fs),
+        getattr(s, f"{name}_range"),
     )
-    lsb = 2.0 * full_scale / 65536.0
+
+
+def _measure(x, triad: _Triad, dtemp, rng, quantize):
+    lsb = 2.0 * triad.full_scale / 65536.0
     out = np.empty_like(x)
     b = np.zeros(3)
-    n_sat = _measure_kernel(
+    n_sat = measure_kernel(
         np.ascontiguousarray(x, dtype=float),
-        T,
-        np.asarray(offset_ref, float),
-        np.asarray(temp_coef, float),
+        triad.matrix,
+        triad.offset,
+        triad.temp_coef,
         dtemp,
-        float(noise_sd),
-        float(walk_sd),
-        -full_scale,
-        full_scale - lsb,
+        float(triad.noise_sd),
+        float(triad.walk_sd),
+        -triad.full_scale,
+        triad.full_scale - lsb,
         lsb,
         bool(quantize),
         int(rng.integers(0, 2**31 - 1)),
@@ -371,6 +317,21 @@ def _measure(
         b,
     )
     return out, b, int(n_sat)
+
+
+def _truth(s: SensorModel, triads: dict, bias: dict, sat: dict, dtemp) -> dict:
+    # the true errors of the accelerometer and gyroscope, as JSON-serialisable attrs
+    names = ("acc", "gyr")
+    out = {f"true_{k}_offset": triads[k].offset.tolist() for k in names}
+    for k in names:
+        out[f"true_{k}_offset_mean"] = (
+            triads[k].offset + np.mean(dtemp) * triads[k].temp_coef + bias[k]
+        ).tolist()
+    out.update({f"true_{k}_matrix": triads[k].matrix.tolist() for k in names})
+    out.update({f"true_{k}_temp_coef": triads[k].temp_coef.tolist() for k in names})
+    out["true_temp_ref"] = s.temp_ref
+    out.update({f"n_saturated_{k}": sat[k] for k in names})
+    return out
 
 
 def apply_sensor_model(
@@ -386,6 +347,7 @@ def apply_sensor_model(
     sensor : SensorModel or None
         ``None`` errors are drawn with :func:`draw_sensor`.
     rng : numpy.random.Generator
+        Random source of the drawn errors and the noise.
     fs : float
         Sampling rate (Hz).
 
@@ -395,6 +357,20 @@ def apply_sensor_model(
         ``acc``, ``gyr`` (and ``mag``) measured, ``temp`` (N,), ``sensor`` (the fully
         drawn :class:`SensorModel`) and ``truth`` (JSON-serialisable attrs: the
         effective mean offsets over the recording, saturation counts ...).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from tiltlab import simulate
+    >>> true = {"acc": np.tile([0.0, 0.0, 1.0], (200, 1)), "gyr": np.zeros((200, 3))}
+    >>> sensor = simulate.SensorModel(
+    ...     acc_offset=(0.05, 0.0, 0.0), gyr_offset=(1.0, -2.0, 0.5)
+    ... )
+    >>> out = simulate.apply_sensor_model(true, sensor, np.random.default_rng(0), 100.0)
+    >>> sorted(out)
+    ['acc', 'gyr', 'sensor', 'temp', 'truth']
+    >>> np.round(out["acc"].mean(axis=0), 2).tolist()  # offset, scale and noise, g
+    [0.05, 0.0, 1.01]
     """
     if fs is None or not np.isfinite(fs) or fs <= 0:
         raise ValueError(f"fs must be a positive number of Hz, got {fs!r}")
@@ -409,62 +385,12 @@ def apply_sensor_model(
     t = np.arange(n) / fs
     temp = s.temp_end + (s.temp_start - s.temp_end) * np.exp(-t / s.temp_tau_s)
     dtemp = temp - s.temp_ref
-    half_bw = math.sqrt(fs / 2.0)
-    sq_dt = math.sqrt(1.0 / fs)
-    acc_m, acc_b, acc_sat = _measure(
-        acc,
-        s.acc_scale,
-        s.acc_misalign,
-        s.acc_offset,
-        s.acc_temp_coef,
-        dtemp,
-        s.acc_noise_density * half_bw,
-        s.acc_bias_walk * sq_dt,
-        rng,
-        s.acc_range,
-        s.quantize,
-    )
-    gyr_m, gyr_b, gyr_sat = _measure(
-        gyr,
-        s.gyr_scale,
-        s.gyr_misalign,
-        s.gyr_offset,
-        s.gyr_temp_coef,
-        dtemp,
-        s.gyr_noise_density * half_bw,
-        s.gyr_bias_walk * sq_dt,
-        rng,
-        s.gyr_range,
-        s.quantize,
-    )
-    out = {"acc": acc_m, "gyr": gyr_m, "temp": temp, "sensor": s}
-    truth = {
-        "true_acc_offset": np.asarray(s.acc_offset, float).tolist(),
-        "true_gyr_offset": np.asarray(s.gyr_offset, float).tolist(),
-        "true_acc_offset_mean": (
-            np.asarray(s.acc_offset)
-            + np.mean(dtemp) * np.asarray(s.acc_temp_coef)
-            + acc_b
-        ).tolist(),
-        "true_gyr_offset_mean": (
-            np.asarray(s.gyr_offset)
-            + np.mean(dtemp) * np.asarray(s.gyr_temp_coef)
-            + gyr_b
-        ).tolist(),
-        "true_acc_matrix": (
-            (np.eye(3) + np.diag(s.acc_scale))
-            @ (np.eye(3) + np.asarray(s.acc_misalign))
-        ).tolist(),
-        "true_gyr_matrix": (
-            (np.eye(3) + np.diag(s.gyr_scale))
-            @ (np.eye(3) + np.asarray(s.gyr_misalign))
-        ).tolist(),
-        "true_acc_temp_coef": np.asarray(s.acc_temp_coef, float).tolist(),
-        "true_gyr_temp_coef": np.asarray(s.gyr_temp_coef, float).tolist(),
-        "true_temp_ref": s.temp_ref,
-        "n_saturated_acc": acc_sat,
-        "n_saturated_gyr": gyr_sat,
-    }
+    triads = {"acc": _triad(s, "acc", fs), "gyr": _triad(s, "gyr", fs)}
+    meas, bias, sat = {}, {}, {}
+    for k, x in (("acc", acc), ("gyr", gyr)):
+        meas[k], bias[k], sat[k] = _measure(x, triads[k], dtemp, rng, s.quantize)
+    out = {"acc": meas["acc"], "gyr": meas["gyr"], "temp": temp, "sensor": s}
+    truth = _truth(s, triads, bias, sat, dtemp)
     if s.magnetometer:
         if "q" not in true:
             raise ValueError("a magnetometer needs the true orientation 'q'")
@@ -522,7 +448,7 @@ def magnetometer_readings(
 
 
 def true_sensor_values(q, a_lin_g) -> np.ndarray:
-    r"""True accelerometer reading (g): :math:`R(q)^\top (e_z + a_{lin})` with ``a_lin`` in g, world frame.
+    r"""Compute the true accelerometer reading (g), :math:`R(q)^\top (e_z + a_{lin})`.
 
     Parameters
     ----------
@@ -666,10 +592,12 @@ def simulate_session(
     seed : int or SeedSequence or None
         Same seed → bit-identical Recording. ``None`` draws fresh entropy.
     behaviour : BehaviourParams, optional
+        Behaviour of the animal (default ``BehaviourParams()``).
     sensor : SensorModel, optional
         Default: every error drawn from the MPU-9250/Fayat distributions;
         :meth:`SensorModel.ideal` for a perfect sensor.
     lesion : Lesion, optional
+        A vestibular lesion applied to the behaviour.
     keep_true : bool
         Also store ``acc_true``, ``gyr_true`` and ``pos``.
     attrs : dict, optional
@@ -679,6 +607,16 @@ def simulate_session(
     -------
     xarray.Dataset
         A validated Recording (see :func:`recording_from_motion`).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from tiltlab import simulate
+    >>> rec = simulate.simulate_session(5.0, 50.0, seed=1)
+    >>> dict(rec.sizes)
+    {'time': 250, 'axis': 3, 'quat': 4}
+    >>> np.round(rec.attrs["true_gyr_offset"], 2).tolist()  # the drawn offset, °/s
+    [-8.99, -13.92, -8.64]
     """
     rng = np.random.default_rng(seed)
     motion = head_kinematics(

@@ -1,4 +1,6 @@
-r"""Synthetic movement for the bio-logging demonstrations of :mod:`tiltlab.trig`:
+r"""Synthetic movement for the bio-logging demonstrations of :mod:`tiltlab.trig`.
+
+Synthetic movement for the bio-logging demonstrations of :mod:`tiltlab.trig`:
 3-D tracks for dead reckoning (Benhamou 2023 §8) and flapping/gliding heave for the
 oscillation statistics (§9).
 """
@@ -20,7 +22,9 @@ __all__ = ["Track", "simulate_track", "simulate_heave"]
 
 
 class Track(NamedTuple):
-    """A simulated 3-D path: positions (n+1, 3) in m, per-step speed (m/s), azimuth and
+    """A simulated 3-D path.
+
+    A simulated 3-D path: positions (n+1, 3) in m, per-step speed (m/s), azimuth and
     elevation (rad), step duration ``dt_s`` (s).
     """
 
@@ -41,7 +45,7 @@ def simulate_track(
     max_elevation: float = 0.6,
     rng: np.random.Generator | int | None = None,
 ) -> Track:
-    """A smooth correlated random walk in 3-D (truth for dead-reckoning demonstrations).
+    """Simulate a smooth correlated random walk in 3-D (truth for dead-reckoning demonstrations).
 
     Azimuth performs a random walk (increments N(0, turn_sd²) per step, rad), elevation
     a mean-reverting walk bounded by ``max_elevation`` (rad), speed a positive
@@ -53,6 +57,22 @@ def simulate_track(
         Number of steps (positions: ``n_steps + 1``).
     dt_s : float
         Step duration (s).
+    mean_speed : float
+        Speed (m/s) around which the log-normal speed varies.
+    turn_sd : float
+        Standard deviation of the azimuth increments (rad per step).
+    pitch_sd : float
+        Standard deviation of the elevation increments (rad per step).
+    max_elevation : float
+        Bound of the elevation (rad).
+    rng : numpy.random.Generator or int, optional
+        Random source or seed.
+
+    Returns
+    -------
+    Track
+        Positions (n_steps + 1, 3) in m, per-step speed (m/s), azimuth and elevation
+        (rad), and the step duration.
     """
     n_steps = _v.integer(n_steps, "n_steps", minimum=1)
     dt_s = _v.positive(dt_s, "dt_s")
@@ -100,8 +120,20 @@ def simulate_heave(
         Duration (s).
     fs : float
         Sampling rate (Hz).
+    flapping : array_like of bool, shape (N,), optional
+        Samples of flapping flight (default the first half).
+    period_s : float
+        Wing-beat period (s).
+    amplitude : float
+        Wing-beat amplitude (g).
+    noise_sd : float
+        Standard deviation of the sensor noise (g).
+    glide_sd : float
+        Marginal standard deviation of the gliding turbulence (g).
     units : str
         Units of the output ('g' or 'm/s^2').
+    rng : numpy.random.Generator or int, optional
+        Random source or seed.
 
     Returns
     -------

@@ -37,7 +37,9 @@ __all__ = ["stage_angles", "stage_quaternion", "tumble_test", "zoh_angular_veloc
 
 
 def zoh_angular_velocity(q, fs: float) -> np.ndarray:
-    r"""Angular velocity (rad/s, sensor frame) whose zero-order-hold integral is ``q``:
+    r"""Compute the angular velocity whose zero-order-hold integral is ``q``.
+
+    Angular velocity (rad/s, sensor frame) whose zero-order-hold integral is ``q``:
     :math:`\omega_k = f_s\,\mathrm{Log}(q_k^* \otimes q_{k+1})`, last sample 0.
 
     Parameters
@@ -85,6 +87,7 @@ def tumble_test(
     fs : float
         Sampling rate (Hz).
     seed : int, SeedSequence or None
+        Same seed → bit-identical Recording; ``None`` draws fresh entropy.
     kind : {"fibonacci", "three_point"}
         Motorised stage visiting a Fibonacci lattice (Fayat App. A.1: 1.2 s holds, pitch
         then roll moves), or a hand-made test with the z, x then y axis up (3 s holds,
@@ -93,6 +96,7 @@ def tumble_test(
         Hold duration and duration of each stage move (defaults 1.2 / 0.4 s for the
         stage, 3.0 / 1.5 s by hand).
     sensor : SensorModel, optional
+        Sensor errors; default every error drawn (:func:`draw_sensor`).
     orientation_error_deg : float, optional
         Standard deviation of the error of each achieved orientation (default 0 for the
         stage, 3° by hand).
@@ -104,6 +108,16 @@ def tumble_test(
         a final return to the start), ``orientation`` (index of the orientation held,
         −1 at the start position and while moving), attrs ``targets`` (the intended
         gravity directions) and the sensor's ``true_*`` errors.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from tiltlab import simulate
+    >>> rec = simulate.tumble_test(8, 50.0, seed=2)
+    >>> rec.sizes["time"], int(rec["trigger"].sum())  # 8 orientations and the return
+    (960, 9)
+    >>> np.round(rec.attrs["true_acc_offset"], 3).tolist()  # g
+    [-0.005, -0.042, -0.036]
     """
     if kind not in ("fibonacci", "three_point"):
         raise ValueError(f"kind must be 'fibonacci' or 'three_point', got {kind!r}")
