@@ -299,7 +299,7 @@ def test_init_refuses_an_undeclared_group_naming_the_file(tmp_path):
             tmp_path,
             "{group}/{subject}_{timepoint}.nc",
             reader="netcdf",
-            groups=["sham", "lesion"],
+            declared=cohort.StudyLabels(groups=["sham", "lesion"]),
         )
     msg = str(err.value)
     assert msg.startswith(

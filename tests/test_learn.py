@@ -249,9 +249,10 @@ def test_saved_model_round_trip_and_closed_loop_run(small_sequences, tmp_path):
     model, _ = learn.train(seqs, cfg, max_steps=5)
     digest = learn.save(model, cfg, seqs[0].fs, tmp_path / "m.pt")
     assert digest == learn.sha256(tmp_path / "m.pt")
-    loaded, cfg2, fs = learn.load(tmp_path / "m.pt")
+    loaded, cfg2, fs = learn.load_model(tmp_path / "m.pt")
     assert cfg2 == cfg and fs == seqs[0].fs
-    q1, q2 = learn.run(model, seqs[0], cfg), learn.run(loaded, seqs[0], cfg)
+    q1 = learn.closed_loop_estimate(model, seqs[0], cfg)
+    q2 = learn.closed_loop_estimate(loaded, seqs[0], cfg)
     assert np.array_equal(q1, q2)
     assert q1.shape == (len(seqs[0]), 4)
     assert np.allclose(np.linalg.norm(q1, axis=1), 1.0, atol=1e-5)
@@ -292,7 +293,7 @@ def test_committed_models_match_their_checksums_and_folds():
             assert any("disturbed" in groups[t] for t in f)
     for variant in run["configs"]:
         for k in range(len(run["folds"])):
-            model, cfg, fs = learn.load(COMMITTED / f"{variant}_fold{k}.pt")
+            model, cfg, fs = learn.load_model(COMMITTED / f"{variant}_fold{k}.pt")
             assert cfg.variant == variant and fs == pytest.approx(285.714, abs=1e-3)
 
 

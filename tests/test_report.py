@@ -162,7 +162,7 @@ def test_manifest_goes_to_the_cohort_chapter_and_recording_on_request(
         "1,8",
         tmp_path / "b",
         book_dir=book,
-        recording=recording,
+        recording_path=recording,
         params={"N": 2},
         render=False,
         progress=False,
@@ -203,7 +203,7 @@ def test_errors_before_running(book, recording, tmp_path, monkeypatch):
         (tmp_path / "logger.csv").write_text("t,ax,ay,az\n0,0,0,1\n")
         run(source=tmp_path / "logger.csv")
     with pytest.raises(report.ReportError, match="goes with a cohort manifest"):
-        run(recording=recording)
+        run(recording_path=recording)
     with pytest.raises(report.ReportError, match="pass --book"):
         run(book_dir=tmp_path)
     monkeypatch.setenv("TILTLAB_BOOK_DIR", str(tmp_path / "nowhere"))

@@ -42,6 +42,7 @@ from ._common import (
     UserError,
     _MAPPING_HELP,
     _add_check_units,
+    _add_out_force,
     _message,
     _user_errors,
 )
@@ -113,15 +114,12 @@ def _parser() -> argparse.ArgumentParser:
     p_conv.add_argument(
         "--mapping", metavar="MAPPING.json", help="column/unit or multi-file mapping"
     )
-    p_conv.add_argument("--out", required=True, help="Recording to write (.nc)")
+    _add_out_force(p_conv, "--out file", required=True, help="Recording to write (.nc)")
     p_conv.add_argument(
         "--preset",
         metavar="NAME",
         help="device axes convention (android, ios, tagtools, animal ...), for sources "
         "whose axes are not in the sensor frame yet",
-    )
-    p_conv.add_argument(
-        "--force", action="store_true", help="replace an existing --out file"
     )
     _add_check_units(p_conv)
 

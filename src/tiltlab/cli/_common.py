@@ -1,4 +1,6 @@
-"""Shared pieces of the command line: exit statuses, the one-line user error, loading a
+"""Share the command line's exit statuses, user error, source loading and options.
+
+Shared pieces of the command line: exit statuses, the one-line user error, loading a
 source and reading options.
 """
 
@@ -94,7 +96,7 @@ def _load(
     check_units: bool = True,
     **options: Any,
 ):
-    """A Recording from a data-source string, or from a CSV with a mapping.
+    """Load a Recording from a data-source string, or from a CSV with a mapping.
 
     A refusal of the unit check names ``--no-check-units``.
     """
@@ -129,7 +131,7 @@ def _load(
 
 
 def _read_json(path: str, what: str) -> Any:
-    """The content of a JSON file; a missing file or bad JSON is a :class:`UserError`."""
+    """Read a JSON file; a missing file or bad JSON is a :class:`UserError`."""
     p = Path(path)
     if not p.is_file():
         raise UserError(f"{path}: no such {what} file", EXIT_REJECTED)
@@ -147,7 +149,7 @@ def _read_json(path: str, what: str) -> Any:
 
 
 def _positive_int(option: str):
-    """An argparse type: an integer >= 1, checked by :mod:`tiltlab._validate`."""
+    """Parse an integer >= 1 (an argparse type), checked by :mod:`tiltlab._validate`."""
     from .. import _validate
 
     def parse(text: str) -> int:
@@ -170,3 +172,19 @@ def _add_check_units(p: argparse.ArgumentParser, where: str = "") -> None:
         help="accept the unit labels as they are, even where the values contradict "
         "them (the unit check refuses, e.g., m/s² values labelled g)" + where,
     )
+
+
+def _add_out_force(p: argparse.ArgumentParser, what: str, **out: Any) -> None:
+    """Add ``--out`` (with the keyword arguments ``out``) and ``--force``.
+
+    ``--force`` replaces an existing ``what`` (see :func:`_writable`).
+    """
+    p.add_argument("--out", **out)
+    p.add_argument("--force", action="store_true", help=f"replace an existing {what}")
+
+
+def _writable(out: Path, force: bool) -> Path:
+    """Return ``out``, refusing to replace an existing file without ``--force``."""
+    if out.exists() and not force:
+        raise UserError(f"{out} exists; give another --out, or --force to replace it")
+    return out

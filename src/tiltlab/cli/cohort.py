@@ -22,10 +22,12 @@ from ._common import (
     EXIT_REJECTED,
     UserError,
     _add_check_units,
+    _add_out_force,
     _message,
     _positive_int,
     _read_json,
     _user_errors,
+    _writable,
 )
 
 
@@ -66,7 +68,9 @@ _SUMMARY_HEAD = re.compile(r"\d+ sessions: \d+ ok, \d+ failed")
 
 
 class _WithoutRunSummary:
-    """stderr during :func:`tiltlab.cohort.run_cohort`: everything passes (the progress
+    """Pass stderr through during a cohort run, except the run's own summary.
+
+    stderr during :func:`tiltlab.cohort.run_cohort`: everything passes (the progress
     bar, warnings) except the summary the run prints at its end, which ``cohort run``
     prints itself, once, on stdout.
     """
@@ -90,7 +94,7 @@ class _WithoutRunSummary:
 
 
 def _name_list(option: str):
-    """An argparse type: comma-separated names (``A,B``), none empty."""
+    """Make an argparse type: comma-separated names (``A,B``), none empty."""
 
     def parse(text: str) -> list[str]:
         names = [n.strip() for n in text.split(",")]
@@ -105,7 +109,7 @@ def _name_list(option: str):
 
 
 def _counts(values) -> str:
-    """``"a (2), b (1)"``: each value and how often, in order of appearance."""
+    """Count each value, in order of appearance: ``"a (2), b (1)"``."""
     import pandas as pd
 
     counts = pd.Series(list(values), dtype=object).astype(str).value_counts(sort=False)
@@ -121,9 +125,7 @@ def _cmd_cohort_init(args: argparse.Namespace) -> int:
     folder = Path(args.folder)
     if not folder.is_dir():
         raise UserError(f"{folder}: no such folder")
-    out = Path(args.out)
-    if out.exists() and not args.force:
-        raise UserError(f"{out} exists; give another --out, or --force to replace it")
+    out = _writable(Path(args.out), args.force)
     options = None
     if args.reader_options is not None:
         text = args.reader_options.strip()
@@ -145,8 +147,10 @@ def _cmd_cohort_init(args: argparse.Namespace) -> int:
         reader=args.reader,
         group=args.group,
         nested_subjects=getattr(args, "nested_subjects", False),
-        groups=getattr(args, "groups", None),
-        timepoints=getattr(args, "timepoints", None),
+        declared=cohort.StudyLabels(
+            groups=getattr(args, "groups", None),
+            timepoints=getattr(args, "timepoints", None),
+        ),
         reader_options=options,
         out=out,
     )
@@ -194,7 +198,7 @@ def _cohort_inputs(args: argparse.Namespace):
 
 
 def _without_unit_check(manifest):
-    """The manifest with ``"check_units": false`` in every row's reader_options."""
+    """Copy the manifest with ``"check_units": false`` in every row's reader_options."""
     import dataclasses
 
     table = manifest.table.copy()
@@ -208,7 +212,7 @@ def _without_unit_check(manifest):
 
 
 def _scheduler(text: str) -> str:
-    """An argparse type for ``--scheduler``: ``dask``, ``processes`` or an address."""
+    """Parse ``--scheduler``: ``dask``, ``processes`` or an address."""
     if text in ("dask", "processes") or "://" in text:
         return text
     raise argparse.ArgumentTypeError(
@@ -274,7 +278,9 @@ def _cmd_cohort_run(args: argparse.Namespace) -> int:
 
 
 def _save_tables(features, out: Path) -> tuple[Path, Path]:
-    """Write ``<out stem>.csv`` (with its ``.columns.csv``) and ``.parquet`` beside
+    """Write the CSV and Parquet tables beside the NetCDF feature file.
+
+    Write ``<out stem>.csv`` (with its ``.columns.csv``) and ``.parquet`` beside
     the NetCDF feature file.
     """
     from .. import cohort
@@ -297,7 +303,7 @@ def _export(table, path: Path) -> Path:
 
 
 def _export_path(text: str) -> Path:
-    """The ``--export`` file of ``cohort show``, checked before any work (exit 2)."""
+    """Check the ``--export`` file of ``cohort show`` before any work (exit 2)."""
     from ..cohort.tables import TABLE_SUFFIXES
 
     path = Path(text)
@@ -327,7 +333,9 @@ MAIN_FEATURES = (
 
 
 def _feature_table(features, max_features: int | None):
-    """Sessions × (labels, status, main features) as a DataFrame; units of the shown
+    """Tabulate sessions with their labels, status and main features.
+
+    Sessions × (labels, status, main features) as a DataFrame; units of the shown
     features; names of the features left out.
     """
     import pandas as pd
@@ -403,7 +411,7 @@ def _cmd_cohort_show(args: argparse.Namespace) -> int:
 
 
 def _config_of(features) -> dict | None:
-    """The feature configuration stored in a feature table's attrs, if any."""
+    """Read the feature configuration stored in a feature table's attrs, if any."""
     for key in ("feature_config", "config"):
         value = features.attrs.get(key)
         if isinstance(value, str):
@@ -448,7 +456,7 @@ _PATTERN_EPILOG = (
 
 
 def _add_cohort(sub) -> None:
-    """The ``cohort`` command's parser (``init``, ``run``, ``show``)."""
+    """Add the ``cohort`` command's parser (``init``, ``run``, ``show``)."""
     p_cohort = sub.add_parser("cohort", help="cohort manifests and features")
     csub = p_cohort.add_subparsers(dest="cohort_cmd", required=True, metavar="COMMAND")
     p_init = csub.add_parser(
@@ -496,8 +504,9 @@ def _add_cohort(sub) -> None:
         "groups is refused",
     )
     _add_declared(p_init)
-    p_init.add_argument(
-        "--out",
+    _add_out_force(
+        p_init,
+        "manifest",
         default="manifest.csv",
         help="manifest to write (default manifest.csv); file paths in it are "
         "relative to its folder",
@@ -507,9 +516,6 @@ def _add_cohort(sub) -> None:
         metavar="JSON|FILE.json",
         help="reader options for every session, as JSON text or a JSON file; for "
         "--reader csv, the column/unit mapping (see 'tiltlab info --help')",
-    )
-    p_init.add_argument(
-        "--force", action="store_true", help="replace an existing manifest"
     )
 
     p_run = csub.add_parser(
@@ -580,7 +586,7 @@ def _add_cohort(sub) -> None:
 
 
 def _add_declared(p: argparse.ArgumentParser) -> None:
-    """``--groups`` and ``--timepoints``: the study's declared names."""
+    """Add ``--groups`` and ``--timepoints``: the study's declared names."""
     p.add_argument(
         "--groups",
         type=_name_list("--groups"),

@@ -14,6 +14,7 @@ from ._common import (
     UserError,
     _CSV_SUFFIXES,
     _load,
+    _writable,
 )
 
 
@@ -37,7 +38,9 @@ def _cmd_fetch(args: argparse.Namespace, parser: argparse.ArgumentParser) -> int
 
 @contextlib.contextmanager
 def _quality_lines(emit):
-    """Collect the warnings of tiltlab (quality warnings and any other warning raised in
+    """Collect tiltlab's warnings while the block runs and emit each once at its end.
+
+    Collect the warnings of tiltlab (quality warnings and any other warning raised in
     the package) while the block runs, and hand each distinct message, in order, to
     ``emit`` when it ends — also when it ends by an error. Other warnings (libraries')
     are shown as usual.
@@ -66,7 +69,7 @@ def _quality_lines(emit):
 
 
 def _looks_like(source: str) -> str | None:
-    """What a file source looks like (:func:`tiltlab.io.detect`), None for names."""
+    """Say what a file source looks like (:func:`tiltlab.io.detect`), None for names."""
     from .. import io
 
     if not Path(source).is_file():
@@ -85,7 +88,9 @@ _NO_CHECKSUM = (
 
 
 def _checksums(source: str, what: str | None) -> str | None:
-    """For a tiltlab NetCDF Recording, what its checksums say: ``"verified (…)"`` or
+    """Say what a tiltlab NetCDF Recording's checksums say, None for other sources.
+
+    For a tiltlab NetCDF Recording, what its checksums say: ``"verified (…)"`` or
     ``"none stored"``; None for any other source.
 
     Called once the file has loaded, which verified the checksums it holds (a
@@ -165,8 +170,7 @@ def _cmd_convert(args: argparse.Namespace) -> int:
         raise UserError(f"--out {out} is a folder; give a file such as session.nc")
     if out.suffix.lower() not in (".nc", ".nc4", ".netcdf"):
         raise UserError(f"--out {out}: a Recording is written as NetCDF; end it in .nc")
-    if out.exists() and not args.force:
-        raise UserError(f"{out} exists; give another --out, or --force to replace it")
+    _writable(out, args.force)
     src = Path(args.source)
     if src.resolve() == out.resolve():
         raise UserError(f"--out {out} is the source itself; give another file")

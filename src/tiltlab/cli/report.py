@@ -36,7 +36,7 @@ TILTLAB_BOOK_DIR, else the checkout this package was installed from (pip install
 
 
 def _param(text: str) -> tuple[str, Any]:
-    """An argparse type: ``NAME=VALUE``, the value parsed as JSON, else a string."""
+    """Parse ``NAME=VALUE`` (an argparse type), the value as JSON, else a string."""
     name, sep, raw = text.partition("=")
     name = name.strip()
     if not sep or not re.fullmatch(r"[A-Za-z_]\w*", name):
@@ -51,7 +51,7 @@ def _param(text: str) -> tuple[str, Any]:
 
 
 def _add_report(sub) -> None:
-    """The ``report`` subcommand's parser."""
+    """Add the ``report`` subcommand's parser."""
     p = sub.add_parser(
         "report",
         help="run chapters of the book on your recording or cohort, as HTML",
@@ -110,7 +110,7 @@ def _cmd_report(args: argparse.Namespace) -> int:
             args.out,
             params=dict(args.params),
             book_dir=args.book,
-            recording=args.recording,
+            recording_path=args.recording,
             render=not args.no_render,
             progress=not args.no_progress,
         )

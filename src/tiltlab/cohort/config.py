@@ -30,7 +30,7 @@ __all__ = ["FeatureConfig"]
 
 
 def _plain(v):
-    """A JSON-friendly copy of a parameter value (numpy → Python, tuples → lists)."""
+    """Copy a parameter value JSON-friendly (numpy → Python, tuples → lists)."""
     if isinstance(v, np.generic):
         return v.item()
     if isinstance(v, (np.ndarray, list, tuple)):
@@ -46,7 +46,9 @@ _DRY_FS = 1e5
 
 
 def _dry_run(method, params: dict, use_mag: bool, where: str = "method_params") -> None:
-    """Run ``method`` on a short synthetic static input, so that an out-of-domain
+    """Try ``method`` on a short synthetic static input to refuse bad parameters early.
+
+    Run ``method`` on a short synthetic static input, so that an out-of-domain
     parameter (a negative cut-off, a NaN gain) is refused when the configuration is
     built, not once per session. Only errors naming a parameter count (the synthetic
     input is valid); the adapters to other packages are not run.
@@ -68,7 +70,9 @@ def _dry_run(method, params: dict, use_mag: bool, where: str = "method_params") 
 
 
 def _resolved(method: Any, params: Any, where: str):
-    """The registry entry of ``method`` and its parameters completed with the defaults,
+    """Complete and type the parameters of ``method`` with its registry defaults.
+
+    The registry entry of ``method`` and its parameters completed with the defaults,
     typed (a numeric parameter is a finite float) and JSON-serialisable.
     """
     name = f"FeatureConfig.{where}"
@@ -190,6 +194,8 @@ class FeatureConfig:
     lesion_side: str = "left"
 
     def __post_init__(self):
+        """Check every field and store the method parameters completed and typed."""
+
         def put(name, value):
             object.__setattr__(self, name, value)
 
@@ -275,7 +281,7 @@ class FeatureConfig:
 
     @classmethod
     def from_dict(cls, d: dict[str, Any]) -> "FeatureConfig":
-        """A configuration from :meth:`to_dict` output; an unknown key is a ValueError."""
+        """Build a configuration from :meth:`to_dict` output (unknown key: ValueError)."""
         if not isinstance(d, dict):
             raise ValueError(f"expected a dict, got {type(d).__name__}")
         names = {f.name for f in fields(cls)}
@@ -306,4 +312,5 @@ class FeatureConfig:
         return hashlib.sha256(self.to_json().encode()).hexdigest()
 
     def __hash__(self) -> int:
+        """Hash by the configuration's content (:meth:`hash`)."""
         return int(self.hash()[:16], 16)

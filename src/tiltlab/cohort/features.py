@@ -54,11 +54,12 @@ References
 from __future__ import annotations
 
 import warnings
+from dataclasses import dataclass
 
 import numpy as np
 import xarray as xr
 
-from .. import __version__
+from .. import __version__, _deprecate
 from .. import behavior as _behavior
 from .. import calibration as _calibration
 from .. import filters as _filters
@@ -76,6 +77,16 @@ NO_GYRO = "needs a gyroscope; the Recording has no 'gyr'"
 
 def _tag(x: float) -> str:
     return f"{x:g}".replace(".", "p").replace("-", "m")
+
+
+def _axis_keys(prefix: str) -> list[str]:
+    """Name the features of one quantity per axis: ``<prefix>_x``, ``_y``, ``_z``."""
+    return [f"{prefix}_{a}" for a in "xyz"]
+
+
+def _per_axis(prefix: str, units: str, text: str) -> dict[str, tuple[str, str]]:
+    """Specs of a per-axis feature, ``text`` formatted with the axis name."""
+    return {k: (units, text.format(a)) for k, a in zip(_axis_keys(prefix), "xyz")}
 
 
 def feature_specs(config: FeatureConfig | None = None) -> dict[str, tuple[str, str]]:
@@ -97,9 +108,9 @@ def feature_specs(config: FeatureConfig | None = None) -> dict[str, tuple[str, s
     spec = {
         "n_samples": ("1", "number of samples analysed (samples in gaps left out)"),
         "duration_s": ("s", "duration of the recording"),
-        "gyr_offset_x": ("deg/s", "gyroscope offset removed, x (session estimate)"),
-        "gyr_offset_y": ("deg/s", "gyroscope offset removed, y (session estimate)"),
-        "gyr_offset_z": ("deg/s", "gyroscope offset removed, z (session estimate)"),
+        **_per_axis(
+            "gyr_offset", "deg/s", "gyroscope offset removed, {} (session estimate)"
+        ),
         "immobile_fraction": (
             "1",
             f"fraction of time immobile (angular speed < {thr}, or without a "
@@ -124,9 +135,9 @@ def feature_specs(config: FeatureConfig | None = None) -> dict[str, tuple[str, s
             "1",
             "fraction of the sphere's area visited by the tilt while moving",
         ),
-        "tilt_immobile_x": ("1", "vMF mean tilt during immobility, sensor x axis"),
-        "tilt_immobile_y": ("1", "vMF mean tilt during immobility, sensor y axis"),
-        "tilt_immobile_z": ("1", "vMF mean tilt during immobility, sensor z axis"),
+        **_per_axis(
+            "tilt_immobile", "1", "vMF mean tilt during immobility, sensor {} axis"
+        ),
         "tilt_immobile_kappa": ("1", "vMF concentration of the tilt during immobility"),
         "tilt_immobile_sagittal_deg": (
             "deg",
@@ -191,7 +202,7 @@ def _dataset(
 
 
 def empty_features(config: FeatureConfig | None = None) -> xr.Dataset:
-    """The feature Dataset of a configuration with every value NaN (a failed session).
+    """Make the feature Dataset of a failed session: every value NaN.
 
     Parameters
     ----------
@@ -208,7 +219,7 @@ def empty_features(config: FeatureConfig | None = None) -> xr.Dataset:
 
 
 def _tumble(cal, config: FeatureConfig):
-    """A Calibration from a tumble-test Recording (or a Calibration given as is)."""
+    """Make a Calibration from a tumble-test Recording (or take a Calibration as is)."""
     if isinstance(cal, _calibration.Calibration):
         return cal
     if not isinstance(cal, xr.Dataset):
@@ -229,7 +240,9 @@ def _tumble(cal, config: FeatureConfig):
 
 
 def _corrected(rec: xr.Dataset, config: FeatureConfig, calibration, notes=None):
-    """Calibrated Recording and the session gyro offset removed (°/s; NaN when it
+    """Calibrate a Recording and remove the session's gyroscope offset.
+
+    Calibrated Recording and the session gyro offset removed (°/s; NaN when it
     could not be estimated, e.g. sustained rotation throughout: then nothing is
     removed and ``notes`` gets the reason).
     """
@@ -258,13 +271,14 @@ def _corrected(rec: xr.Dataset, config: FeatureConfig, calibration, notes=None):
     return rec, off
 
 
+@_deprecate.renamed(recording="rec")
 def session_tilt(
-    recording: xr.Dataset,
+    rec: xr.Dataset,
     config: FeatureConfig | None = None,
     *,
     calibration=None,
 ) -> tuple[xr.Dataset, xr.DataArray]:
-    """The corrected Recording and the tilt of one session, as the feature pipeline sees them.
+    """Correct one session and find its tilt, as the feature pipeline sees them.
 
     The first steps of :func:`session_features`, for figures that need the per-sample data
     (tilt maps, angular velocity in a gravity-aligned frame): the tumble-test calibration
@@ -273,7 +287,7 @@ def session_tilt(
 
     Parameters
     ----------
-    recording : xarray.Dataset
+    rec : xarray.Dataset
         A Recording; not modified.
     config : FeatureConfig, optional
         Default :class:`FeatureConfig()`.
@@ -288,12 +302,14 @@ def session_tilt(
         Gravity-up direction in the sensor frame (time, axis), with ``fs`` and the method.
     """
     config = config or FeatureConfig()
-    rec, _ = _corrected(recording, config, calibration)
-    return rec, _tilt(rec, config)
+    corrected, _ = _corrected(rec, config, calibration)
+    return corrected, _tilt(corrected, config)
 
 
 def _tilt_method(rec: xr.Dataset, config: FeatureConfig) -> tuple[str, dict, bool]:
-    """The method, parameters and ``use_mag`` for this Recording: ``config.method``
+    """Choose the tilt method, its parameters and ``use_mag`` for this Recording.
+
+    The method, parameters and ``use_mag`` for this Recording: ``config.method``
     when the Recording has what it needs, else ``config.no_gyro_method``.
     """
     have = {v for v in _filters.SENSORS if v in rec}
@@ -303,7 +319,9 @@ def _tilt_method(rec: xr.Dataset, config: FeatureConfig) -> tuple[str, dict, boo
 
 
 def _tilt(rec: xr.Dataset, config: FeatureConfig) -> xr.DataArray:
-    """Gravity-up direction of a corrected Recording with the configured method (or,
+    """Estimate the gravity-up direction of a corrected Recording.
+
+    Gravity-up direction of a corrected Recording with the configured method (or,
     without the sensors it needs, ``config.no_gyro_method``).
     """
     method, params, use_mag = _tilt_method(rec, config)
@@ -325,8 +343,9 @@ def _immobile(speed, config: FeatureConfig, threshold: float) -> np.ndarray:
     )
 
 
+@_deprecate.renamed(recording="rec")
 def session_features(
-    recording: xr.Dataset,
+    rec: xr.Dataset,
     config: FeatureConfig | None = None,
     *,
     calibration=None,
@@ -336,7 +355,7 @@ def session_features(
 
     Parameters
     ----------
-    recording : xarray.Dataset
+    rec : xarray.Dataset
         A Recording (``acc``, ``gyr`` with units; ``fs``); not modified.
     config : FeatureConfig, optional
         Every choice of the pipeline (default :class:`FeatureConfig()`).
@@ -398,18 +417,97 @@ def session_features(
     ----------
     .. [1] R. Fayat et al., Sensors 21(18):6318, 2021. doi:10.3390/s21186318
     """
+    config = _checked(rec, config, check_units)
+    acc = _Features(feature_specs(config))
+    has_gyr = "gyr" in rec
+    offset_notes: list[str] = []
+    corrected, off = _corrected(rec, config, calibration, offset_notes)
+    _offset_features(acc, has_gyr, offset_notes, off)
+    _check_length(corrected)
+    s = _samples(corrected, _tilt(corrected, config))
+    _immobility(acc, s, config)
+    _visited_features(acc, s, config)
+    _tilt_immobile_features(acc, s, config)
+    _motion_features(acc, s, config)
+    _acceleration_features(acc, s, config)
+    method, _, _ = _tilt_method(corrected, config)
+    attrs = {
+        "source": str(rec.attrs.get("source", "")),
+        "sensors": ", ".join(v for v in _filters.SENSORS if v in rec),
+        "tilt_method": method,
+        "immobility_rule": s.rule,
+        **s.gaps,
+    }
+    return _dataset(acc.out, config, attrs, acc.reasons)
+
+
+def _checked(rec, config: FeatureConfig | None, check_units: bool) -> FeatureConfig:
+    """Check both inputs and return the configuration (default ``FeatureConfig()``)."""
     config = config or FeatureConfig()
     if not isinstance(config, FeatureConfig):
         raise TypeError(f"config must be a FeatureConfig, got {type(config).__name__}")
-    if not isinstance(recording, xr.Dataset):
+    if not isinstance(rec, xr.Dataset):
         raise TypeError(
-            "recording must be a Recording (xarray.Dataset), got "
-            f"{type(recording).__name__}"
+            f"rec must be a Recording (xarray.Dataset), got {type(rec).__name__}"
         )
-    _schema.validate(recording, allow_nan=True, check_units=check_units)
-    has_gyr = "gyr" in recording
-    offset_notes: list[str] = []
-    rec, off = _corrected(recording, config, calibration, offset_notes)
+    _schema.validate(rec, allow_nan=True, check_units=check_units)
+    return config
+
+
+class _Features:
+    """The feature values found so far, and the reasons of those left undefined."""
+
+    def __init__(self, spec: dict[str, tuple[str, str]]):
+        self.spec = spec
+        self.out: dict[str, float] = {}
+        self.reasons: dict[str, str] = {}
+
+    def undefined(self, keys, reason: str) -> None:
+        """Record why the features ``keys`` are NaN (the first reason given wins)."""
+        for k in keys:
+            self.reasons.setdefault(k, reason)
+
+    def speed_keys(self) -> list[str]:
+        """List the names of the angular-speed quantile features."""
+        return [k for k in self.spec if k.startswith("angular_speed_moving_q")]
+
+
+@dataclass
+class _Samples:
+    """The corrected session, its tilt and the samples the features are computed on."""
+
+    rec: xr.Dataset  # corrected Recording
+    g: xr.DataArray  # gravity-up direction, every sample
+    valid: np.ndarray  # samples outside gaps
+    n: int
+    gaps: dict[str, str]
+    speed: xr.DataArray | None = None  # angular speed (°/s, gaps at 1e9)
+    imm: np.ndarray | None = None  # immobile, valid samples only
+    rule: str = ""
+
+    @property
+    def has_gyr(self) -> bool:
+        """Whether the session has a gyroscope."""
+        return "gyr" in self.rec
+
+    @property
+    def n_valid(self) -> int:
+        """Number of samples outside gaps."""
+        return int(self.valid.sum())
+
+    @property
+    def gv(self) -> np.ndarray:
+        """Tilt of the valid samples, (n_valid, 3)."""
+        return self.g.values[self.valid]
+
+    @property
+    def moving(self) -> np.ndarray:
+        """Moving valid samples."""
+        return ~self.imm
+
+
+def _check_length(rec: xr.Dataset) -> None:
+    """Refuse a session shorter than 2 s."""
     fs = float(rec.attrs["fs"])
     n = rec.sizes["time"]
     if n < 2 * fs:
@@ -417,27 +515,16 @@ def session_features(
             f"the recording is too short for the features ({n} samples, {n / fs:.2f} s;"
             " at least 2 s needed)"
         )
-    spec = feature_specs(config)
-    reasons: dict[str, str] = {}
 
-    def undefined(keys, reason: str) -> None:
-        for k in keys:
-            reasons.setdefault(k, reason)
 
-    out: dict[str, float] = {"duration_s": n / fs}
-    offset_keys = [f"gyr_offset_{a}" for a in "xyz"]
-    speed_keys = [k for k in spec if k.startswith("angular_speed_moving_q")]
-    if not has_gyr:
-        undefined(offset_keys, NO_GYRO)
-    elif offset_notes:
-        undefined(offset_keys, offset_notes[0])
-    else:
-        out.update({k: float(o) for k, o in zip(offset_keys, off)})
+def _samples(rec: xr.Dataset, g: xr.DataArray) -> _Samples:
+    """Find the samples outside gaps, refusing a session with less than 2 s of them.
 
-    method, _, _ = _tilt_method(rec, config)
-    g = _tilt(rec, config)
-    # samples in gaps (non-finite sensor values, hence no tilt) are left out below;
-    # the immobility rules count them as neither still nor moving
+    Samples in gaps (non-finite sensor values, hence no tilt) are left out of every
+    feature; the immobility rules count them as neither still nor moving.
+    """
+    fs = float(rec.attrs["fs"])
+    n = rec.sizes["time"]
     valid = np.isfinite(g.values).all(axis=1)
     for v in ("acc", "gyr"):
         if v in rec:
@@ -453,102 +540,126 @@ def session_features(
         if n_valid == n
         else {"gaps": f"{n - n_valid} of {n} samples in gaps left out"}
     )
-    out["n_samples"] = n_valid
-    gv = g.values[valid]
-    if has_gyr:
+    return _Samples(rec=rec, g=g, valid=valid, n=n, gaps=gaps)
+
+
+def _offset_features(acc: _Features, has_gyr: bool, notes: list[str], off) -> None:
+    """Duration and the session's gyroscope offset (or why it is undefined)."""
+    keys = _axis_keys("gyr_offset")
+    if not has_gyr:
+        acc.undefined(keys, NO_GYRO)
+    elif notes:
+        acc.undefined(keys, notes[0])
+    else:
+        acc.out.update({k: float(o) for k, o in zip(keys, off)})
+
+
+def _immobility(acc: _Features, s: _Samples, config: FeatureConfig) -> None:
+    """Immobility by the gyroscope or accelerometer rule, and its valley threshold."""
+    fs = float(s.rec.attrs["fs"])
+    acc.out["duration_s"] = s.n / fs
+    acc.out["n_samples"] = s.n_valid
+    if s.has_gyr:
         # a gap is never still: a speed above any threshold there (left out below)
-        speed = _behavior.angular_speed(rec).fillna(1e9)
-        sp = np.asarray(speed, float)[valid]
-        imm = _immobile(speed, config, config.threshold_deg_s)[valid]
-        rule = (
+        s.speed = _behavior.angular_speed(s.rec).fillna(1e9)
+        s.imm = _immobile(s.speed, config, config.threshold_deg_s)[s.valid]
+        s.rule = (
             f"gyroscope: angular speed < {config.threshold_deg_s:g} deg/s, gaps < "
             f"{config.merge_gap_s:g} s merged, periods < {config.min_duration_s:g} s "
             "dropped"
         )
     else:
         still = _behavior.acc_immobility(
-            rec,
+            s.rec,
             threshold_g=config.acc_threshold_g,
             window_s=config.acc_window_s,
             smooth_s=config.acc_smooth_s,
             merge_gap_s=config.merge_gap_s,
             min_duration_s=config.min_duration_s,
         )
-        imm = np.asarray(still, dtype=bool)[valid]
-        rule = f"accelerometer: {still.attrs['rule_description']}"
-    moving = ~imm
-    out["immobile_fraction"] = float(imm.mean())
+        s.imm = np.asarray(still, dtype=bool)[s.valid]
+        s.rule = f"accelerometer: {still.attrs['rule_description']}"
+    acc.out["immobile_fraction"] = float(s.imm.mean())
     auto_keys = ["immobility_threshold_auto", "immobile_fraction_auto"]
     if not config.auto_threshold:
-        undefined(auto_keys, "not computed (config.auto_threshold is False)")
-    elif not has_gyr:
-        undefined(auto_keys, NO_GYRO + " (valley of the angular-speed histogram)")
+        acc.undefined(auto_keys, "not computed (config.auto_threshold is False)")
+    elif not s.has_gyr:
+        acc.undefined(auto_keys, NO_GYRO + " (valley of the angular-speed histogram)")
     else:
         try:
-            thr = _behavior.valley_threshold(speed[valid])
+            thr = _behavior.valley_threshold(s.speed[s.valid])
         except ValueError as exc:
-            undefined(auto_keys, str(exc))
+            acc.undefined(auto_keys, str(exc))
         else:
-            out["immobility_threshold_auto"] = float(thr)
-            out["immobile_fraction_auto"] = float(
-                _immobile(speed, config, thr)[valid].mean()
+            acc.out["immobility_threshold_auto"] = float(thr)
+            acc.out["immobile_fraction_auto"] = float(
+                _immobile(s.speed, config, thr)[s.valid].mean()
             )
 
+
+def _visited_features(acc: _Features, s: _Samples, config: FeatureConfig) -> None:
+    """Fraction of the sphere's area visited, all samples and while moving."""
     mesh = _sphere.sphere_mesh(config.mesh_n)
+    moving = s.moving
     for key, mask in (("visited_fraction", None), ("visited_fraction_moving", moving)):
         if mask is not None and not mask.any():
-            undefined([key], "no moving samples")
+            acc.undefined([key], "no moving samples")
             continue
-        tmap = _sphere.tilt_map(g[valid], mesh=mesh, mask=mask)
-        out[key] = _sphere.visited_fraction(
+        tmap = _sphere.tilt_map(s.g[s.valid], mesh=mesh, mask=mask)
+        acc.out[key] = _sphere.visited_fraction(
             tmap, mesh, min_count=config.visited_min_count, by="area"
         )
 
-    tilt_keys = [f"tilt_immobile_{a}" for a in "xyz"]
-    tilt_keys += ["tilt_immobile_kappa", "tilt_immobile_sagittal_deg"]
-    if imm.sum() >= 2:
-        fit = _sphere.vmf_fit(gv[imm])
-        out.update({f"tilt_immobile_{a}": float(m) for a, m in zip("xyz", fit.mu)})
-        out["tilt_immobile_kappa"] = float(fit.kappa)
-        out["tilt_immobile_sagittal_deg"] = float(
-            np.degrees(_sphere.sagittal_angle(fit.mu, config.lesion_side))
-        )
-    else:
-        undefined(tilt_keys, f"fewer than 2 immobile samples ({int(imm.sum())})")
 
-    if not has_gyr:
-        undefined(["circling_index", *speed_keys], NO_GYRO)
-    elif moving.any():
-        whole = n_valid == n
-        out["circling_index"] = _behavior.circling_index(
-            rec if whole else rec.isel(time=valid),
-            g if whole else g[valid],
-            moving=moving,
-        )
-        for q in config.speed_quantiles:
-            key = f"angular_speed_moving_q{_tag(100 * q)}"
-            out[key] = float(np.quantile(sp[moving], q))
-    else:
-        undefined(["circling_index", *speed_keys], "no moving samples")
+def _tilt_immobile_features(acc: _Features, s: _Samples, config: FeatureConfig) -> None:
+    """Fit the vMF mean tilt during immobility, its concentration and sagittal angle."""
+    keys = _axis_keys("tilt_immobile")
+    keys += ["tilt_immobile_kappa", "tilt_immobile_sagittal_deg"]
+    if s.imm.sum() < 2:
+        acc.undefined(keys, f"fewer than 2 immobile samples ({int(s.imm.sum())})")
+        return
+    fit = _sphere.vmf_fit(s.gv[s.imm])
+    acc.out.update({k: float(m) for k, m in zip(keys, fit.mu)})
+    acc.out["tilt_immobile_kappa"] = float(fit.kappa)
+    acc.out["tilt_immobile_sagittal_deg"] = float(
+        np.degrees(_sphere.sagittal_angle(fit.mu, config.lesion_side))
+    )
 
-    to_g = _units.conversion_factor(rec["acc"].attrs["units"], "g")
+
+def _motion_features(acc: _Features, s: _Samples, config: FeatureConfig) -> None:
+    """Circling index and angular-speed quantiles while moving (gyroscope only)."""
+    keys = ["circling_index", *acc.speed_keys()]
+    moving = s.moving
+    if not s.has_gyr:
+        acc.undefined(keys, NO_GYRO)
+        return
+    if not moving.any():
+        acc.undefined(keys, "no moving samples")
+        return
+    whole = s.n_valid == s.n
+    acc.out["circling_index"] = _behavior.circling_index(
+        s.rec if whole else s.rec.isel(time=s.valid),
+        s.g if whole else s.g[s.valid],
+        moving=moving,
+    )
+    sp = np.asarray(s.speed, float)[s.valid]
+    for q in config.speed_quantiles:
+        key = f"angular_speed_moving_q{_tag(100 * q)}"
+        acc.out[key] = float(np.quantile(sp[moving], q))
+
+
+def _acceleration_features(acc: _Features, s: _Samples, config: FeatureConfig) -> None:
+    """Mean DBA and ODBA (g), and the fractions of time tilted beyond thresholds."""
+    to_g = _units.conversion_factor(s.rec["acc"].attrs["units"], "g")
     # DBA is NaN where its window touches a gap
-    out["dba_mean"] = float(
-        np.nanmean(_behavior.dba(rec, window_s=config.dba_window_s)) * to_g
+    acc.out["dba_mean"] = float(
+        np.nanmean(_behavior.dba(s.rec, window_s=config.dba_window_s)) * to_g
     )
-    out["odba_mean"] = float(
-        np.nanmean(_behavior.odba(rec, window_s=config.dba_window_s)) * to_g
+    acc.out["odba_mean"] = float(
+        np.nanmean(_behavior.odba(s.rec, window_s=config.dba_window_s)) * to_g
     )
+    gv = s.gv
     gz = np.clip(gv[:, 2] / np.linalg.norm(gv, axis=1), -1.0, 1.0)
     tilt_deg = np.degrees(np.arccos(gz))
     for t in config.tilt_thresholds_deg:
-        out[f"tilted_fraction_{_tag(t)}deg"] = float(np.mean(tilt_deg > t))
-
-    attrs = {
-        "source": str(recording.attrs.get("source", "")),
-        "sensors": ", ".join(v for v in _filters.SENSORS if v in recording),
-        "tilt_method": method,
-        "immobility_rule": rule,
-        **gaps,
-    }
-    return _dataset(out, config, attrs, reasons)
+        acc.out[f"tilted_fraction_{_tag(t)}deg"] = float(np.mean(tilt_deg > t))

@@ -17,20 +17,22 @@ References
 
 from __future__ import annotations
 
+import functools
 import json
 import re
 import warnings
-from collections.abc import Mapping, Sequence
+from collections.abc import Mapping
+from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, NamedTuple
 
 import pandas as pd
 
 from .. import io as _io
-from .manifest import _RESTART_INIT, Manifest, _check_table, _portable
+from .manifest import _RESTART_INIT, Manifest, StudyLabels, _check_table, _portable
 from .sessions import READERS, session_path
 
-__all__ = ["PATTERN_HELP", "init_manifest"]
+__all__ = ["PATTERN_HELP", "StudyLabels", "init_manifest"]
 
 
 #: The grammar of :func:`init_manifest`'s patterns, in words (also ``--help``).
@@ -56,7 +58,7 @@ _FIELD = re.compile(r"\{(\w+)\}")
 
 
 def _pattern_regex(pattern: str) -> tuple[re.Pattern, list[str]]:
-    """The regular expression of a pattern (see :data:`PATTERN_HELP`) and its fields.
+    """Compile a pattern (:data:`PATTERN_HELP`) to a regex; list its fields.
 
     Each field becomes a greedy ``[^/]+`` (a field named again, a back-reference).
     """
@@ -100,7 +102,7 @@ def _pattern_regex(pattern: str) -> tuple[re.Pattern, list[str]]:
 
 
 def _user_regex(regex: str | re.Pattern) -> tuple[re.Pattern, list[str]]:
-    """A user's regular expression and its named groups (the fields)."""
+    """Compile a user's regular expression and list its named groups (the fields)."""
     if isinstance(regex, re.Pattern):
         compiled = regex
     else:
@@ -120,7 +122,9 @@ def _user_regex(regex: str | re.Pattern) -> tuple[re.Pattern, list[str]]:
 
 
 def _broad_layout(path: Path) -> bool:
-    """True for an HDF5 file with the variables of a BROAD trial (which
+    """Tell whether an HDF5 file has the variables of a BROAD trial.
+
+    True for an HDF5 file with the variables of a BROAD trial (which
     :func:`tiltlab.io.detect` may describe as a NetCDF-4 file, h5netcdf opening any
     HDF5 file).
     """
@@ -137,7 +141,9 @@ def _broad_layout(path: Path) -> bool:
 
 
 def _reader_from_content(path: Path, label: str) -> str:
-    """The reader of a file, chosen from its content (:func:`tiltlab.io.detect`);
+    """Choose the reader of a file from its content (:func:`tiltlab.io.detect`).
+
+    The reader of a file, chosen from its content (:func:`tiltlab.io.detect`);
     a file of another kind is refused, listing the readers to choose from.
     """
     choices = ", ".join(r for r in READERS if r != "auto")
@@ -171,6 +177,32 @@ def _reader_from_content(path: Path, label: str) -> str:
     )
 
 
+def _old_label_keywords(func):
+    """Accept ``groups=`` and ``timepoints=`` (now ``declared=``), with a warning."""
+
+    @functools.wraps(func)
+    def wrapper(*args, **kwargs):
+        old = {k: kwargs.pop(k) for k in ("groups", "timepoints") if k in kwargs}
+        if old:
+            if kwargs.get("declared") is not None:
+                raise TypeError(
+                    f"{func.__name__}: pass declared= only (groups= and timepoints= "
+                    "are its old form)"
+                )
+            warnings.warn(
+                f"{func.__name__}: {' and '.join(f'{k}=' for k in old)} moved into "
+                "declared=StudyLabels(groups=..., timepoints=...); the old keywords go "
+                "in the next release",
+                FutureWarning,
+                stacklevel=2,
+            )
+            kwargs["declared"] = StudyLabels(**old)
+        return func(*args, **kwargs)
+
+    return wrapper
+
+
+@_old_label_keywords
 def init_manifest(
     folder,
     pattern: str | None = None,
@@ -179,8 +211,7 @@ def init_manifest(
     reader: str | None = None,
     group: str | Mapping[str, str] | None = None,
     nested_subjects: bool = False,
-    groups: Sequence[str] | str | None = None,
-    timepoints: Sequence[str] | str | None = None,
+    declared: StudyLabels | None = None,
     reader_options: Mapping[str, Any] | None = None,
     calibration: str | Mapping[str, str] | None = None,
     out=None,
@@ -218,10 +249,11 @@ def init_manifest(
         two animals): name each subject ``<group>-<subject>`` (``A-rat1``), and a
         ``{session}`` field's id likewise. Without it a subject found in two groups is
         refused.
-    groups, timepoints : sequence of str, or str, optional
-        The study's declared groups and time points (a sequence, or a comma-separated
-        string); a file whose group or time point is not declared (a typo) is
-        refused, as by :func:`~tiltlab.cohort.read_manifest`.
+    declared : StudyLabels, optional
+        The study's declared groups and time points; a file whose group or time point
+        is not declared (a typo) is refused, as by
+        :func:`~tiltlab.cohort.read_manifest`. The keywords ``groups=`` and
+        ``timepoints=`` of earlier releases still work, with a ``FutureWarning``.
     reader_options : mapping, optional
         Reader options for every row (stored as JSON).
     calibration : str or mapping, optional
@@ -249,12 +281,58 @@ def init_manifest(
         What :func:`~tiltlab.cohort.read_manifest` rejects (a subject in two groups, a session id or a
         subject and time point twice, one recording twice, an undeclared group or time
         point …), naming the file, as the manifest is not written yet.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> from tiltlab import cohort
+    >>> folder = Path(tempfile.mkdtemp())
+    >>> for name in ["A/rat1_d0.nc", "A/rat1_d7.nc", "B/rat2_d0.nc"]:
+    ...     (folder / name).parent.mkdir(exist_ok=True)
+    ...     _ = (folder / name).write_text(name)  # stands for a recording
+    >>> m = cohort.init_manifest(
+    ...     folder,
+    ...     "{group}/{subject}_{timepoint}.nc",
+    ...     reader="netcdf",
+    ...     declared=cohort.StudyLabels(groups="A,B", timepoints="d0,d7"),
+    ... )
+    >>> m.sessions
+    ['rat1_d0', 'rat1_d7', 'rat2_d0']
+    >>> m.table[["subject", "group", "timepoint", "file"]].values.tolist()[0]
+    ['rat1', 'A', 'd0', 'A/rat1_d0.nc']
     """
     folder = Path(folder).resolve()
     if not folder.is_dir():
         raise FileNotFoundError(f"{folder}: no such folder")
     if reader is not None and reader not in READERS:
         raise ValueError(f"unknown reader {reader!r}; known: {sorted(READERS)}")
+    layout = _layout(pattern, regex, group)
+    rows = _Rows(
+        folder=folder,
+        layout=layout,
+        reader=reader,
+        group=group,
+        nested_subjects=nested_subjects,
+        reader_options=json.dumps(dict(reader_options or {}), sort_keys=True),
+        calibration=calibration,
+    )
+    found = [r for p in sorted(folder.rglob("*")) if (r := rows.row(p)) is not None]
+    if not found:
+        raise ValueError(f"no file under {folder} matches {layout.shown}")
+    return _written(found, folder, declared or StudyLabels(), out)
+
+
+class _Layout(NamedTuple):
+    """A pattern or regex compiled, its fields and how messages show it."""
+
+    compiled: re.Pattern
+    fields: list[str]
+    shown: str
+
+
+def _layout(pattern, regex, group) -> _Layout:
+    """Compile the pattern or the regex (exactly one given) and check its fields."""
     if (pattern is None) == (regex is None):
         raise ValueError(
             "give a pattern (e.g. '{group}/{subject}_{timepoint}.nc') or a regex with "
@@ -276,59 +354,85 @@ def init_manifest(
             f"pattern {shown} has no {{group}} field: give group= (a name or a "
             "mapping subject → group)"
         )
-    rows, labels = [], []
-    for p in sorted(folder.rglob("*")):
+    return _Layout(compiled, fields, shown)
+
+
+@dataclass(frozen=True)
+class _Rows:
+    """The options of :func:`init_manifest` that make a file's row."""
+
+    folder: Path
+    layout: _Layout
+    reader: str | None
+    group: str | Mapping[str, str] | None
+    nested_subjects: bool
+    reader_options: str  # JSON
+    calibration: str | Mapping[str, str] | None
+
+    def row(self, p: Path) -> tuple[dict[str, str], str] | None:
+        """Make the row of a file and its label (None if the file does not match)."""
         if not p.is_file():
-            continue
-        rel = p.relative_to(folder).as_posix()
-        m = compiled.fullmatch(rel)
+            return None
+        rel = p.relative_to(self.folder).as_posix()
+        m = self.layout.compiled.fullmatch(rel)
         if m is None:
-            continue
+            return None
         label = f"file {rel!r}"
         f = {k: ("" if v is None else str(v)) for k, v in m.groupdict().items()}
         found = f.get("subject") or f.get("session", "")
         tp = f.get("timepoint", "")
-        if "group" in f:
-            grp = f["group"]
-        elif isinstance(group, Mapping):
-            if found not in group:
-                raise ValueError(
-                    f"{label}: the group mapping has no entry for subject {found!r}"
-                )
-            grp = str(group[found])
-        else:
-            grp = str(group)
-        subject = f"{grp}-{found}" if nested_subjects else found
+        grp = self._group(f, found, label)
+        subject = f"{grp}-{found}" if self.nested_subjects else found
         session = f.get("session", "")
-        if session and nested_subjects:
+        if session and self.nested_subjects:
             session = f"{grp}-{session}"
         session = session or (f"{subject}_{tp}" if tp else subject)
-        cal = ""
-        if isinstance(calibration, Mapping):
-            cal = str(calibration.get(subject, calibration.get(found, "")))
-        elif calibration is not None:
-            try:
-                cal = str(calibration).format(**{**f, "subject": found, "group": grp})
-            except (KeyError, IndexError) as exc:
-                raise ValueError(
-                    f"calibration pattern {calibration!r} names {exc}, which is not a "
-                    f"field of the pattern ({', '.join(fields)})"
-                ) from None
+        cal = self._calibration(f, found, subject, grp)
         row = {
             "session": session,
             "subject": subject,
             "group": grp,
             "timepoint": tp,
             "file": str(p),
-            "reader": reader or _reader_from_content(p, label),
-            "reader_options": json.dumps(dict(reader_options or {}), sort_keys=True),
-            "calibration": str(session_path(cal, folder)) if cal else "",
+            "reader": self.reader or _reader_from_content(p, label),
+            "reader_options": self.reader_options,
+            "calibration": str(session_path(cal, self.folder)) if cal else "",
         }
         row.update({k: v for k, v in f.items() if k not in row})
-        rows.append(row)
-        labels.append(label)
-    if not rows:
-        raise ValueError(f"no file under {folder} matches {shown}")
+        return row, label
+
+    def _group(self, f: dict[str, str], found: str, label: str) -> str:
+        """Find the group of a file: its field, else the mapping or the one name."""
+        if "group" in f:
+            return f["group"]
+        if isinstance(self.group, Mapping):
+            if found not in self.group:
+                raise ValueError(
+                    f"{label}: the group mapping has no entry for subject {found!r}"
+                )
+            return str(self.group[found])
+        return str(self.group)
+
+    def _calibration(self, f: dict[str, str], found: str, subject: str, grp: str):
+        """Find the subject's tumble-test path as given (``""`` when none)."""
+        cal = self.calibration
+        if isinstance(cal, Mapping):
+            return str(cal.get(subject, cal.get(found, "")))
+        if cal is None:
+            return ""
+        try:
+            return str(cal).format(**{**f, "subject": found, "group": grp})
+        except (KeyError, IndexError) as exc:
+            raise ValueError(
+                f"calibration pattern {cal!r} names {exc}, which is not a "
+                f"field of the pattern ({', '.join(self.layout.fields)})"
+            ) from None
+
+
+def _written(found, folder: Path, declared: StudyLabels, out) -> Manifest:
+    """Validate the rows found as a manifest, and write it to ``out`` if given."""
+    rows = [r for r, _ in found]
+    labels = [label for _, label in found]
     df = pd.DataFrame(rows)
     base = Path(out).resolve().parent if out is not None else folder
     for c in ("file", "calibration"):
@@ -338,8 +442,8 @@ def init_manifest(
         df.astype(str),
         base,
         name,
-        groups,
-        timepoints=timepoints,
+        declared.groups,
+        timepoints=declared.timepoints,
         labels=labels,
         restart_hint=_RESTART_INIT,
     )

@@ -38,7 +38,7 @@ UNIT_TEXT: dict[str, str] = {
 
 
 def feature_name(feature: str) -> str:
-    """The short display name of a feature.
+    """Give the short display name of a feature.
 
     Parameters
     ----------
@@ -61,7 +61,7 @@ def feature_name(feature: str) -> str:
 
 
 def feature_units(feature: str, config: FeatureConfig | None = None) -> str:
-    """A feature's units as text for an axis or a column header.
+    """Give a feature's units as text for an axis or a column header.
 
     Parameters
     ----------
@@ -98,7 +98,7 @@ def feature_units(feature: str, config: FeatureConfig | None = None) -> str:
 def feature_label(
     feature: str, config: FeatureConfig | None = None, *, prefix: str = ""
 ) -> str:
-    """An axis label: ``prefix``, the short name and the units in parentheses.
+    """Make an axis label: ``prefix``, the short name and the units in parentheses.
 
     Parameters
     ----------

@@ -28,7 +28,7 @@ def session_row(
     timepoint,
     sessions: pd.DataFrame | None = None,
 ) -> dict[str, Any]:
-    """The manifest row of a subject's session at a time point.
+    """Find the manifest row of a subject's session at a time point.
 
     Parameters
     ----------
@@ -82,7 +82,7 @@ def session_row(
 def load_session_tilt(
     row: Mapping[str, Any], root, config: FeatureConfig | None = None
 ) -> tuple[xr.Dataset, xr.DataArray]:
-    """A session's corrected Recording and tilt, as the feature pipeline computes them.
+    """Load a session's corrected Recording and tilt, as the features see them.
 
     Reads the row's recording (:func:`~tiltlab.cohort.load_session`) and tumble test
     (:func:`~tiltlab.cohort.load_calibration`) and applies

@@ -44,12 +44,6 @@ Each session's recording is read by :func:`load_session` (with the reader regist
 :func:`~tiltlab.cohort.init_manifest` (in :mod:`~tiltlab.cohort.initialize`) writes a
 manifest from the files of a folder whose paths match a pattern or an explicit regular
 expression.
-
-References
-----------
-.. [1] R. Fayat et al., "Inertial Measurement of Head Tilt in Rodents: Principles and
-   Applications to Vestibular Research", Sensors 21(18):6318, 2021.
-   doi:10.3390/s21186318
 """
 
 from __future__ import annotations
@@ -66,6 +60,7 @@ from typing import Any
 
 import pandas as pd
 
+from ..datasets import file_sha256
 from .sessions import (
     _CALIBRATION_READERS,
     READERS,
@@ -82,6 +77,7 @@ __all__ = [
     "READERS",
     "ManifestError",
     "ManifestWarning",
+    "StudyLabels",
     "Manifest",
     "read_manifest",
     "load_session",
@@ -100,8 +96,27 @@ REQUIRED_COLUMNS: tuple[str, ...] = (
 OPTIONAL_COLUMNS: tuple[str, ...] = ("reader_options", "calibration")
 
 
+@dataclass(frozen=True)
+class StudyLabels:
+    """The groups and time points a study declares (a label not among them is a typo).
+
+    Attributes
+    ----------
+    groups : sequence of str, or str, optional
+        The study's groups (a sequence, or one comma-separated string such as
+        ``"sham,lesion"``); None declares none.
+    timepoints : sequence of str, or str, optional
+        The study's time points, likewise (compared as text: ``"0"``, ``"d7"``).
+    """
+
+    groups: Sequence[str] | str | None = None
+    timepoints: Sequence[str] | str | None = None
+
+
 class ManifestWarning(UserWarning):
-    """A manifest that is valid but looks wrong (e.g. two group labels one letter
+    """Warn of a manifest that is valid but looks wrong.
+
+    A manifest that is valid but looks wrong (e.g. two group labels one letter
     apart).
     """
 
@@ -126,6 +141,7 @@ class Manifest:
     path: Path | None = None
 
     def __len__(self) -> int:
+        """Count the sessions."""
         return len(self.table)
 
     @property
@@ -144,7 +160,7 @@ class Manifest:
         yield from self.table.to_dict("records")
 
     def row(self, session: str) -> dict[str, Any]:
-        """The row of one session."""
+        """Return the row of one session."""
         sel = self.table[self.table["session"] == session]
         if len(sel) != 1:
             raise KeyError(f"no session {session!r} in the manifest")
@@ -170,7 +186,9 @@ class Manifest:
 
 
 def _portable(path, base) -> str:
-    """``path`` relative to the folder ``base`` (POSIX separators), or absolute when no
+    """Make ``path`` relative to the folder ``base`` (POSIX separators) where possible.
+
+    ``path`` relative to the folder ``base`` (POSIX separators), or absolute when no
     relative path exists (another drive).
     """
     try:
@@ -222,7 +240,9 @@ def _maybe_numeric(col: pd.Series) -> pd.Series:
 
 
 def _declared_names(names, what: str) -> list[str] | None:
-    """A study's declared groups or time points: a sequence, or one comma-separated
+    """Parse a study's declared groups or time points.
+
+    A study's declared groups or time points: a sequence, or one comma-separated
     string; None when not declared.
     """
     if names is None:
@@ -263,15 +283,11 @@ def _fingerprint(path: str, size: int) -> bytes:
 
 
 def _sha256(path: str) -> bytes:
-    h = hashlib.sha256()
-    with open(path, "rb") as f:
-        for chunk in iter(lambda: f.read(1 << 20), b""):
-            h.update(chunk)
-    return h.digest()
+    return bytes.fromhex(file_sha256(path))
 
 
 def _same_content(paths: Sequence[str]) -> tuple[int, int] | None:
-    """The first ``(j, i)``, ``j < i``, of two existing files with the same bytes.
+    """Find the first ``(j, i)``, ``j < i``, of two existing files with the same bytes.
 
     Only files of equal size are read: first three sampled blocks, and the whole file
     (SHA-256) only where those agree. Files that cannot be read are left out.
@@ -320,6 +336,27 @@ def _check_table(
     Rows are named ``"<name>, line N"`` (``N`` 1-based with the header as line 1), or
     by ``labels[i]`` when given (a table that is not a file yet).
     """
+    df = _normalised(df, name)
+    groups = _declared_names(groups, "group")
+    timepoints = _declared_names(timepoints, "time point")
+    rows = _RowNames(df.to_dict("records"), name, labels)
+    seen = _Seen(rows, root, restart_hint)
+    for i, row in enumerate(rows.records):
+        at = rows.where(i, row["session"] or None)
+        _check_cells(row, at)
+        _check_declared(row["group"], groups, "group", at)
+        _check_declared(row["timepoint"], timepoints, "time point", at)
+        seen.add(i, row, at)
+    seen.check_contents()
+    known = set(REQUIRED_COLUMNS) | set(OPTIONAL_COLUMNS)
+    for c in ["timepoint"] + [c for c in df.columns if c not in known]:
+        df[c] = _maybe_numeric(df[c])
+    order = list(REQUIRED_COLUMNS) + list(OPTIONAL_COLUMNS)
+    return df[order + [c for c in df.columns if c not in order]].reset_index(drop=True)
+
+
+def _normalised(df: pd.DataFrame, name: str) -> pd.DataFrame:
+    """Check the header and the rows; add the optional columns, strip cells."""
     missing = [c for c in REQUIRED_COLUMNS if c not in df.columns]
     if missing:
         raise ManifestError(
@@ -335,105 +372,150 @@ def _check_table(
     df = df.fillna("").astype(str)
     for c in df.columns:
         df[c] = df[c].str.strip()
-    groups = _declared_names(groups, "group")
-    timepoints = _declared_names(timepoints, "time point")
+    return df
 
-    def ref(i: int) -> str:  # another row, after "is also ..."
-        return f"on line {i + 2}" if labels is None else f"in {labels[i]}"
 
-    def where(i: int, session: str | None) -> str:
-        head = _where(name, i + 2) if labels is None else str(labels[i])
+def _check_cells(row: dict[str, str], at: str) -> None:
+    """Check one row's own cells: required fields, reader, its options, calibration."""
+    for c in ("session", "subject", "group", "file", "reader"):
+        if not row[c]:
+            raise ManifestError(f"{at}: empty {c!r}")
+    if row["reader"] not in READERS:
+        raise ManifestError(
+            f"{at}: unknown reader {row['reader']!r}; known: {sorted(READERS)}"
+        )
+    _options(row["reader_options"], row["reader"], at)
+    cal = row["calibration"]
+    if cal and Path(cal).suffix.lower() not in _CALIBRATION_READERS:
+        raise ManifestError(
+            f"{at}: calibration file {cal!r} must be .nc (NetCDF) or .csv "
+            "(Fayat tumble test)"
+        )
+
+
+@dataclass(frozen=True)
+class _RowNames:
+    """How messages name a manifest's rows: by line, or by ``labels`` (no file yet)."""
+
+    records: list[dict[str, str]]
+    name: str
+    labels: Sequence[str] | None
+
+    def ref(self, i: int) -> str:
+        """Name another row, after "is also ..."."""
+        return f"on line {i + 2}" if self.labels is None else f"in {self.labels[i]}"
+
+    def where(self, i: int, session: str | None) -> str:
+        """Name a row at the head of a message."""
+        if self.labels is None:
+            head = _where(self.name, i + 2)
+        else:
+            head = str(self.labels[i])
         return f"{head} (session {session!r})" if session else head
 
-    def this_file(i: int) -> str:
-        return f"file {records[i]['file']!r}" if labels is None else "this file"
+    def this_file(self, i: int) -> str:
+        """Name a row's file, in a message about that row."""
+        if self.labels is None:
+            return f"file {self.records[i]['file']!r}"
+        return "this file"
 
-    def other(j: int) -> str:  # another row's file
-        sid = records[j]["session"]
-        if labels is None:
-            return f"{records[j]['file']!r} {ref(j)} (session {sid!r})"
-        return f"{labels[j]} (session {sid!r})"
+    def other(self, j: int) -> str:
+        """Name another row's file."""
+        sid = self.records[j]["session"]
+        if self.labels is None:
+            return f"{self.records[j]['file']!r} {self.ref(j)} (session {sid!r})"
+        return f"{self.labels[j]} (session {sid!r})"
 
-    records = df.to_dict("records")
-    group_of: dict[str, tuple[str, int]] = {}
-    seen_session: dict[str, int] = {}
-    seen_cell: dict[tuple[str, str], int] = {}
-    seen_file: dict[str, int] = {}
-    seen_real: dict[str, int] = {}
-    real_paths: list[str] = []
-    for i, row in enumerate(records):
-        sid = row["session"] or None
-        at = where(i, sid)
-        for c in ("session", "subject", "group", "file", "reader"):
-            if not row[c]:
-                raise ManifestError(f"{at}: empty {c!r}")
-        if row["reader"] not in READERS:
-            raise ManifestError(
-                f"{at}: unknown reader {row['reader']!r}; known: {sorted(READERS)}"
-            )
-        _options(row["reader_options"], row["reader"], at)
-        cal = row["calibration"]
-        if cal and Path(cal).suffix.lower() not in _CALIBRATION_READERS:
-            raise ManifestError(
-                f"{at}: calibration file {cal!r} must be .nc (NetCDF) or .csv "
-                "(Fayat tumble test)"
-            )
-        _check_declared(row["group"], groups, "group", at)
-        _check_declared(row["timepoint"], timepoints, "time point", at)
-        subject, group, tp = row["subject"], row["group"], row["timepoint"]
-        if subject in group_of and group_of[subject][0] != group:
-            first_group, j = group_of[subject]
-            hint = restart_hint.format(example=f"{group}-{subject}")
+
+class _Seen:
+    """What the rows so far have used: a row that repeats one of them is refused."""
+
+    def __init__(self, rows: _RowNames, root: Path, restart_hint: str):
+        self.rows, self.root, self.restart_hint = rows, root, restart_hint
+        self.group_of: dict[str, tuple[str, int]] = {}
+        self.session: dict[str, int] = {}
+        self.cell: dict[tuple[str, str], int] = {}
+        self.file: dict[str, int] = {}
+        self.real: dict[str, int] = {}
+        self.real_paths: list[str] = []
+
+    def add(self, i: int, row: dict[str, str], at: str) -> None:
+        """Check row ``i`` against the rows before it, then record it."""
+        self._subject(i, row, at)
+        self._session(i, row, at)
+        self._file(i, row, at)
+        self._cell(i, row, at)
+
+    def _subject(self, i: int, row: dict[str, str], at: str) -> None:
+        """Refuse a subject in two groups."""
+        subject, group = row["subject"], row["group"]
+        if subject in self.group_of and self.group_of[subject][0] != group:
+            first_group, j = self.group_of[subject]
+            hint = self.restart_hint.format(example=f"{group}-{subject}")
             raise ManifestError(
                 f"{at}: subject {subject!r} is in group {group!r} here and in group "
-                f"{first_group!r} {ref(j)} (session {records[j]['session']!r}); a "
-                f"subject belongs to one group. {hint}"
+                f"{first_group!r} {self.rows.ref(j)} (session "
+                f"{self.rows.records[j]['session']!r}); a subject belongs to one "
+                f"group. {hint}"
             )
-        group_of.setdefault(subject, (group, i))
-        if row["session"] in seen_session:
+        self.group_of.setdefault(subject, (group, i))
+
+    def _session(self, i: int, row: dict[str, str], at: str) -> None:
+        """Refuse a session id used twice."""
+        if row["session"] in self.session:
             raise ManifestError(
                 f"{at}: session id {row['session']!r} already used "
-                f"{ref(seen_session[row['session']])}"
+                f"{self.rows.ref(self.session[row['session']])}"
             )
-        seen_session[row["session"]] = i
-        path = session_path(row["file"], root)
+        self.session[row["session"]] = i
+
+    def _file(self, i: int, row: dict[str, str], at: str) -> None:
+        """Refuse a file named twice, by its path or through a link."""
+        path = session_path(row["file"], self.root)
         key = os.path.normcase(os.path.abspath(path))
-        if key in seen_file:
+        if key in self.file:
             raise ManifestError(
-                f"{at}: file {row['file']!r} is already named {ref(seen_file[key])}"
+                f"{at}: file {row['file']!r} is already named "
+                f"{self.rows.ref(self.file[key])}"
             )
-        seen_file[key] = i
+        self.file[key] = i
         real = os.path.normcase(os.path.realpath(path))
-        if real in seen_real:
-            j = seen_real[real]
+        if real in self.real:
+            j = self.real[real]
             raise ManifestError(
-                f"{at}: {this_file(i)} is the same file as {other(j)}, through a link "
-                "or another spelling of its path: one recording listed twice"
+                f"{at}: {self.rows.this_file(i)} is the same file as "
+                f"{self.rows.other(j)}, through a link or another spelling of its "
+                "path: one recording listed twice"
             )
-        seen_real[real] = i
-        real_paths.append(real)
-        if (subject, tp) in seen_cell:
-            j = seen_cell[(subject, tp)]
+        self.real[real] = i
+        self.real_paths.append(real)
+
+    def _cell(self, i: int, row: dict[str, str], at: str) -> None:
+        """Refuse two sessions of one subject at one time point."""
+        subject, tp = row["subject"], row["timepoint"]
+        if (subject, tp) in self.cell:
+            j = self.cell[(subject, tp)]
             when = f"at time point {tp!r}" if tp else "without a time point"
             raise ManifestError(
                 f"{at}: subject {subject!r} already has a session {when} (session "
-                f"{records[j]['session']!r} {ref(j)}); one session per subject and "
-                "time point, or the statistics count one animal twice: give the "
-                "sessions distinct time points (e.g. 'd7' and 'd7b'), or leave one out"
+                f"{self.rows.records[j]['session']!r} {self.rows.ref(j)}); one "
+                "session per subject and time point, or the statistics count one "
+                "animal twice: give the sessions distinct time points (e.g. 'd7' and "
+                "'d7b'), or leave one out"
             )
-        seen_cell[(subject, tp)] = i
-    twins = _same_content(real_paths)
-    if twins is not None:
-        j, i = twins
-        raise ManifestError(
-            f"{where(i, records[i]['session'])}: {this_file(i)} has the same content "
-            f"as {other(j)}: one recording listed twice (a copy?)"
-        )
-    known = set(REQUIRED_COLUMNS) | set(OPTIONAL_COLUMNS)
-    for c in ["timepoint"] + [c for c in df.columns if c not in known]:
-        df[c] = _maybe_numeric(df[c])
-    order = list(REQUIRED_COLUMNS) + list(OPTIONAL_COLUMNS)
-    return df[order + [c for c in df.columns if c not in order]].reset_index(drop=True)
+        self.cell[(subject, tp)] = i
+
+    def check_contents(self) -> None:
+        """Refuse two files with the same content (one recording copied)."""
+        twins = _same_content(self.real_paths)
+        if twins is not None:
+            j, i = twins
+            rows = self.rows
+            raise ManifestError(
+                f"{rows.where(i, rows.records[i]['session'])}: {rows.this_file(i)} "
+                f"has the same content as {rows.other(j)}: one recording listed "
+                "twice (a copy?)"
+            )
 
 
 def read_manifest(
@@ -493,7 +575,9 @@ def read_manifest(
 
 
 def _warn_near_duplicates(column, what: str, keyword: str, where: str) -> None:
-    """Warn when two labels of a column differ by a letter or two (``translaton`` next
+    """Warn when two labels of a column differ by a letter or two.
+
+    Warn when two labels of a column differ by a letter or two (``translaton`` next
     to ``translation``): likely a typo that would make a group or time point of its
     own. Only a warning: labels such as ``d1``/``d7`` are close on purpose; declaring
     the labels (``keyword``) makes an undeclared one an error.

@@ -8,12 +8,6 @@ arrives, atomically (a temporary file renamed into place), so a killed run leave
 corrupt entry and a restarted run resumes where it stopped. A session that cannot be
 read or computed becomes a row with ``status = "failed"``, its ``error`` and NaN
 features; the others complete.
-
-References
-----------
-.. [1] R. Fayat et al., "Inertial Measurement of Head Tilt in Rodents: Principles and
-   Applications to Vestibular Research", Sensors 21(18):6318, 2021.
-   doi:10.3390/s21186318
 """
 
 from __future__ import annotations
@@ -34,8 +28,9 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
-from .. import __version__
+from .. import __version__, _deprecate
 from .. import io as _io
+from ..datasets import file_sha256
 from ..quality import UnitCheckError
 from .config import FeatureConfig
 from .features import feature_specs, session_features
@@ -79,7 +74,7 @@ def _calibration_file(
 
 
 def _check_units(row: dict) -> bool:
-    """False when the row's reader_options say ``"check_units": false``."""
+    """Tell whether to check units (not if reader_options say so)."""
     opts = row.get("reader_options", "")
     if not isinstance(opts, dict):
         try:
@@ -150,11 +145,7 @@ def compute_session(row: dict, root: str, config: FeatureConfig) -> dict[str, An
 
 def _sha256(path: Path) -> str | None:
     try:
-        h = hashlib.sha256()
-        with open(path, "rb") as f:
-            for chunk in iter(lambda: f.read(1 << 20), b""):
-                h.update(chunk)
-        return h.hexdigest()
+        return file_sha256(path)
     except OSError:
         return None
 
@@ -167,7 +158,9 @@ def _options_of(row) -> dict:
 def cache_key(
     row: dict, root, config: FeatureConfig, *, digests: dict | None = None
 ) -> str | None:
-    """The cache key of a session: SHA-256 over its file's bytes, its calibration
+    """Compute the cache key of a session.
+
+    The cache key of a session: SHA-256 over its file's bytes, its calibration
     file's bytes, the reader and its options, the configuration's hash and the package
     version. None when a file cannot be read (such a session is always recomputed).
     ``digests`` (path → SHA-256) memoises file digests over one run (a subject's
@@ -235,7 +228,9 @@ def _cache_get(cache: Path, key: str | None, names) -> xr.Dataset | None:
 
 
 def _write_atomically(path, write: Callable[[Path], object]) -> Path:
-    """Call ``write(tmp)`` on a temporary file beside ``path``, then rename it into
+    """Write a file atomically: through a temporary file renamed into place.
+
+    Call ``write(tmp)`` on a temporary file beside ``path``, then rename it into
     place (:func:`os.replace`): a reader sees the old file or the new one, never half
     of one, and a failed ``write`` leaves no temporary file behind.
     """
@@ -474,7 +469,9 @@ def run_cohort(
 
 @dataclass(frozen=True)
 class CohortSummary:
-    """Outcome of a cohort run: counts, per failed session the reason, and per session
+    """Summarise a cohort run.
+
+    Outcome of a cohort run: counts, per failed session the reason, and per session
     that ran with NaN features why they are NaN.
     """
 
@@ -487,6 +484,7 @@ class CohortSummary:
     notes: dict[str, str] = field(default_factory=dict)
 
     def __str__(self) -> str:
+        """Describe the run in a few lines."""
         head = f"{self.n_sessions} sessions: {self.n_ok} ok, {self.n_failed} failed"
         if self.n_computed is not None:
             head += f" ({self.n_computed} computed, {self.n_cached} from cache)"
@@ -502,7 +500,7 @@ class CohortSummary:
 
 
 def summary(features: xr.Dataset) -> CohortSummary:
-    """Counts of ok and failed sessions, and why each failed, of a cohort Dataset.
+    """Count ok and failed sessions of a cohort Dataset, and why each failed.
 
     Parameters
     ----------
@@ -548,14 +546,17 @@ def summary(features: xr.Dataset) -> CohortSummary:
     )
 
 
-def save_features(ds: xr.Dataset, path) -> Path:
-    """Save a feature table to NetCDF (exact round trip with :func:`load_features`),
-    atomically. :func:`~tiltlab.cohort.save_table` writes it as CSV or Parquet.
+@_deprecate.renamed(ds="features")
+def save_features(features: xr.Dataset, path) -> Path:
+    """Save a feature table to NetCDF, atomically.
+
+    The round trip with :func:`load_features` is exact;
+    :func:`~tiltlab.cohort.save_table` writes the table as CSV or Parquet.
 
     Parameters
     ----------
-    ds : xarray.Dataset
-        Feature table.
+    features : xarray.Dataset
+        Feature table (of :func:`run_cohort`).
     path : str or os.PathLike
         Output NetCDF file.
 
@@ -567,11 +568,11 @@ def save_features(ds: xr.Dataset, path) -> Path:
     Raises
     ------
     TypeError
-        If ``ds`` is not an xarray.Dataset.
+        If ``features`` is not an xarray.Dataset.
     """
-    if not isinstance(ds, xr.Dataset):
-        raise TypeError(f"expected an xarray.Dataset, got {type(ds).__name__}")
-    return _write_atomically(path, lambda tmp: _io.save_netcdf(ds, tmp))
+    if not isinstance(features, xr.Dataset):
+        raise TypeError(f"expected an xarray.Dataset, got {type(features).__name__}")
+    return _write_atomically(path, lambda tmp: _io.save_netcdf(features, tmp))
 
 
 def load_features(path) -> xr.Dataset:

@@ -65,6 +65,13 @@ def exit_with_parent(parent: int, poll_s: float = 1.0) -> None:
     a daemon thread checks every ``poll_s`` seconds that the parent is still the one
     that started it, and exits otherwise. Without it a killed ``cohort run`` leaves its
     pool workers (and so the multiprocessing resource tracker) running.
+
+    Parameters
+    ----------
+    parent : int
+        Process id of the parent.
+    poll_s : float
+        Seconds between two checks of the watching thread.
     """
     try:
         import ctypes
@@ -147,7 +154,7 @@ class _Dask:
 
 
 def backend(scheduler, workers: int | None):
-    """The back end for a ``scheduler`` argument of :func:`run_cohort` (see there).
+    """Choose the back end for a ``scheduler`` argument of :func:`run_cohort`.
 
     Parameters
     ----------

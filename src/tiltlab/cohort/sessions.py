@@ -5,13 +5,8 @@ session's recording; :func:`load_session` reads a row's recording with it (with 
 row's ``reader_options``, checked as :func:`~tiltlab.cohort.read_manifest` checks
 them), and :func:`load_calibration` the row's tumble test. :func:`session_path`
 resolves a row's relative ``file`` against the manifest's folder. A malformed row is
-a :class:`ManifestError`.
-
-References
-----------
-.. [1] R. Fayat et al., "Inertial Measurement of Head Tilt in Rodents: Principles and
-   Applications to Vestibular Research", Sensors 21(18):6318, 2021.
-   doi:10.3390/s21186318
+a :class:`ManifestError`. The package :mod:`tiltlab.cohort` gives the reference of
+the study design (Fayat et al. 2021).
 """
 
 from __future__ import annotations
@@ -44,7 +39,9 @@ def _read_netcdf(
     quat_atol: float = 1e-6,
     check_units: bool = True,
 ) -> xr.Dataset:
-    """A NetCDF Recording (:func:`tiltlab.io.load_netcdf`), validated with these
+    """Read a NetCDF Recording (:func:`tiltlab.io.load_netcdf`) and validate it.
+
+    A NetCDF Recording (:func:`tiltlab.io.load_netcdf`), validated with these
     options of :func:`tiltlab.schema.validate`.
     """
     kw = {"max_jitter": max_jitter, "quat_atol": quat_atol, "check_units": check_units}
@@ -68,7 +65,9 @@ _CALIBRATION_READERS = {".nc": "netcdf", ".netcdf": "netcdf", ".csv": "fayat_tum
 
 
 class ManifestError(ValueError):
-    """A manifest is malformed; the message names the line (or, for
+    """Signal a malformed manifest.
+
+    A manifest is malformed; the message names the line (or, for
     :func:`~tiltlab.cohort.init_manifest`, the file) and the session.
     """
 
@@ -132,7 +131,7 @@ def session_path(file, root) -> Path:
 
 
 def _takes(func: Callable[..., Any], name: str) -> bool:
-    """True if ``func`` accepts the keyword ``name`` (explicitly or through ``**``)."""
+    """Tell whether ``func`` accepts the keyword ``name`` (itself or by ``**``)."""
     try:
         params = inspect.signature(func).parameters
     except (TypeError, ValueError):
@@ -188,7 +187,7 @@ def load_session(row: Mapping[str, Any], root) -> xr.Dataset:
 
 
 def load_calibration(row: Mapping[str, Any], root) -> xr.Dataset | None:
-    """The tumble-test Recording named in a manifest row's ``calibration``, or None.
+    """Load the tumble test named in a manifest row's ``calibration``, or None.
 
     ``.nc`` files are read with :func:`tiltlab.io.load_netcdf` (validated), ``.csv``
     files with :func:`tiltlab.io.read_fayat_tumble`.

@@ -129,7 +129,7 @@ _SUPPORTED = ".csv (UTF-8, units in the sidecar <stem>.columns.csv) and .parquet
 
 
 def to_table(features: xr.Dataset) -> pd.DataFrame:
-    """The cohort feature Dataset as a tidy table: one row per session.
+    """Convert the cohort feature Dataset to a tidy table: one row per session.
 
     Parameters
     ----------
@@ -156,11 +156,29 @@ def to_table(features: xr.Dataset) -> pd.DataFrame:
 
     Examples
     --------
-    >>> from tiltlab import cohort                                 # doctest: +SKIP
-    >>> df = cohort.to_table(cohort.load_features("features.nc"))  # doctest: +SKIP
-    >>> df[["subject", "status", "dba_mean"]].head()               # doctest: +SKIP
-    >>> df.attrs["units"]["dba_mean"]                              # doctest: +SKIP
-    'g'
+    A two-session feature Dataset, as :func:`~tiltlab.cohort.run_cohort` makes (one
+    feature here; :func:`~tiltlab.cohort.load_features` reads a saved one):
+
+    >>> import xarray as xr
+    >>> from tiltlab import cohort
+    >>> feats = xr.Dataset(
+    ...     {
+    ...         "status": ("session", ["ok", "failed"]),
+    ...         "dba_mean": ("session", [0.123, float("nan")], {"units": "g"}),
+    ...     },
+    ...     coords={
+    ...         "session": ["rat1_d0", "rat2_d0"],
+    ...         "subject": ("session", ["rat1", "rat2"]),
+    ...         "group": ("session", ["sham", "lesion"]),
+    ...     },
+    ... )
+    >>> df = cohort.to_table(feats)
+    >>> list(df.columns)
+    ['session', 'subject', 'group', 'status', 'dba_mean']
+    >>> df["dba_mean"].tolist()
+    [0.123, nan]
+    >>> df.attrs["units"]["dba_mean"], df.attrs["role"]["dba_mean"]
+    ('g', 'feature')
     """
     ds = _check_features(features)
     ids = [c for c in ID_COLUMNS if c in ds.variables]
@@ -252,7 +270,7 @@ def _text(value: Any) -> str:
 
 
 def _plain(value: Any) -> Any:
-    """A Dataset attribute as a plain Python (JSON-able) value."""
+    """Convert a Dataset attribute to a plain Python (JSON-able) value."""
     if isinstance(value, bytes):
         return value.decode("utf-8")
     if isinstance(value, np.ndarray):
@@ -268,7 +286,7 @@ def _plain(value: Any) -> Any:
 
 
 def sidecar_path(path: str | os.PathLike) -> Path:
-    """The data dictionary written beside a CSV table: ``<stem>.columns.csv``.
+    """Name the data dictionary written beside a CSV table: ``<stem>.columns.csv``.
 
     Parameters
     ----------
@@ -365,7 +383,7 @@ def save_table(features: xr.Dataset | pd.DataFrame, path: str | os.PathLike) -> 
 
 
 def _check_frame(df: pd.DataFrame, where: str = "the table") -> pd.DataFrame:
-    """A copy of a cohort table given as a DataFrame, its string columns as strings."""
+    """Copy a cohort table given as a DataFrame, its string columns as strings."""
     columns = [str(c) for c in df.columns]
     missing = [c for c in ("session", "status") if c not in columns]
     if missing:
@@ -420,7 +438,7 @@ def _dtype_name(col: pd.Series) -> str:
 
 
 def _dictionary(df: pd.DataFrame) -> pd.DataFrame:
-    """The data dictionary of a table: one row per column (:data:`SIDECAR_COLUMNS`)."""
+    """Make the data dictionary of a table: one row per column."""
     units = df.attrs.get("units", {}) or {}
     long_name = df.attrs.get("long_name", {}) or {}
     role = df.attrs.get("role", {}) or {}
@@ -594,7 +612,7 @@ _INT = re.compile(r"^[+-]?\d+$")
 def _parse(
     col: pd.Series, dtype: str | None, name: str, path: Path, side: Path
 ) -> pd.Series:
-    """A CSV column (strings) as ``dtype``; guessed (int, float or string) if None."""
+    """Parse a CSV column of strings as ``dtype`` (guessed if None)."""
     values = [v.strip() for v in col.tolist()]
     if dtype is None:  # no data dictionary: numbers where every cell is one
         filled = [v for v in values if v]

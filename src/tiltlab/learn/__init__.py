@@ -1,7 +1,9 @@
-"""Learned orientation estimation (Zaheer et al. 2023): a dilated 1-D CNN fusing
-gyro-integrated quaternions with accelerometer and magnetometer windows, its
-learned-gain variant, their losses, RAdam + Lookahead training with augmentations,
-closed-loop inference and grouped cross-validation on BROAD.
+"""Estimate orientation with learned networks (Zaheer et al. 2023).
+
+A dilated 1-D CNN fusing gyro-integrated quaternions with accelerometer and
+magnetometer windows, its learned-gain variant, their losses, RAdam + Lookahead
+training with augmentations, closed-loop inference and grouped cross-validation on
+BROAD.
 
 Needs the optional extra ``learn`` (CPU PyTorch): ``pip install tiltlab[learn]``.
 Command line: ``python -m tiltlab.learn train --help``.
@@ -23,54 +25,45 @@ except ImportError as err:  # pragma: no cover - depends on the environment
         "(pip install 'tiltlab[learn]')"
     ) from err
 
+import tiltlab.learn.data as _data
+import tiltlab.learn.model as _model
+import tiltlab.learn.optim as _optim
+import tiltlab.learn.published as _published
+import tiltlab.learn.tables as _tables
+import tiltlab.learn.training as _training
+
 from .data import Sequence, sequence, window_ends
 from .losses import LOSSES, TOTALS, qae, sample_loss, total_loss
 from .model import ACTIVATIONS, OrientationCNN
 from .optim import Lookahead, radam_lookahead
-from .training import (
-    TrainConfig,
-    build_model,
-    load,
-    read_sums,
-    run,
-    save,
-    sha256,
-    train,
-)
+from .training import SUMS_FILE, TrainConfig, build_model, closed_loop_estimate
+from .training import load_model, read_sums, save, sha256, train
+from .training import load, run  # the old names, for one release
 from .published import ZAHEER_TABLE2, ZAHEER_TABLE3
-from .cv import BASELINES, check_files, compare, cross_validate, folds, learned_estimate
+from .cv import BASELINES, ERROR_COLUMNS, check_files, compare, compare_summary
+from .cv import cross_validate, folds, learned_estimate
 from .tables import config_table, layer_settings, layer_table
 
+# every public name of data, model, optim, training, published and tables; of
+# losses and cv, those listed here
 __all__ = [
-    "Sequence",
-    "sequence",
-    "window_ends",
+    *_data.__all__,
     "LOSSES",
     "TOTALS",
     "qae",
     "sample_loss",
     "total_loss",
-    "ACTIVATIONS",
-    "OrientationCNN",
-    "Lookahead",
-    "radam_lookahead",
-    "TrainConfig",
-    "build_model",
-    "train",
-    "run",
-    "save",
-    "load",
-    "sha256",
-    "read_sums",
+    *_model.__all__,
+    *_optim.__all__,
+    *_training.__all__,
     "BASELINES",
+    "ERROR_COLUMNS",
     "check_files",
     "compare",
+    "compare_summary",
     "cross_validate",
     "folds",
     "learned_estimate",
-    "ZAHEER_TABLE2",
-    "ZAHEER_TABLE3",
-    "config_table",
-    "layer_settings",
-    "layer_table",
+    *_published.__all__,
+    *_tables.__all__,
 ]

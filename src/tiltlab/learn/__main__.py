@@ -1,4 +1,6 @@
-"""``python -m tiltlab.learn``: train the learned estimators with grouped
+"""Train the learned estimators from the command line: ``python -m tiltlab.learn``.
+
+``python -m tiltlab.learn``: train the learned estimators with grouped
 cross-validation on BROAD, check committed model files.
 
 Examples
@@ -23,6 +25,18 @@ from .training import TrainConfig
 
 
 def main(argv: Sequence[str] | None = None) -> int:
+    """Run the ``learn`` command line.
+
+    Parameters
+    ----------
+    argv : sequence of str, optional
+        The arguments (default: ``sys.argv[1:]``).
+
+    Returns
+    -------
+    int
+        The exit status.
+    """
     p = argparse.ArgumentParser(prog="python -m tiltlab.learn", description=__doc__)
     sub = p.add_subparsers(dest="cmd", required=True)
     t = sub.add_parser("train", help="grouped cross-validation on BROAD")

@@ -1,4 +1,6 @@
-r"""Grouped cross-validation on BROAD, the committed model files, and the comparison
+r"""Cross-validate the learned estimators on BROAD and compare them with filters.
+
+Grouped cross-validation on BROAD, the committed model files, and the comparison
 table against filters and RIANN.
 
 Folds are groups of whole trials: no window of a test trial is ever seen in training.
@@ -12,7 +14,7 @@ Files written by :func:`cross_validate` (the ``learn`` command) in its output fo
 * ``history.json``: training curves (per variant, fold and epoch);
 * ``metrics.json``: per test trial, QAE (Eq. 4, degrees) and BROAD's RMSEs;
 * ``SHA256SUMS``: the sha256 of every file above, checked by :func:`check_files`,
-  and by :func:`load` for each weights file it loads.
+  and by :func:`load_model` for each weights file it loads.
 """
 
 from __future__ import annotations
@@ -27,24 +29,17 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from .. import _deprecate
 from .. import _validate as _v
+from .._labels import label_columns
 from .. import datasets
 from .. import evaluate
 from .. import filters
 from .. import quaternion as quat
 from .data import sequence
 from ..io import IntegrityError
-from .training import (
-    SUMS_FILE,
-    TrainConfig,
-    load,
-    read_sums,
-    run,
-    save,
-    sha256,
-    train,
-    write_json,
-)
+from .training import SUMS_FILE, TrainConfig, closed_loop_estimate, load_model
+from .training import read_sums, save, sha256, train, write_json
 
 __all__ = [
     "ABLATIONS",
@@ -55,8 +50,19 @@ __all__ = [
     "trial_errors",
     "learned_estimate",
     "compare",
+    "compare_summary",
     "BASELINES",
+    "ERROR_COLUMNS",
 ]
+
+#: Error columns of :func:`trial_errors` and :func:`compare`: name → long name (deg).
+ERROR_COLUMNS: dict[str, str] = {
+    "inclination": "inclination RMSE",
+    "heading": "heading RMSE",
+    "total": "total RMSE",
+    "qae_mean": "mean QAE",
+    "qae_median": "median QAE",
+}
 
 #: Baselines of the comparison: label -> (registry method, 9D)
 BASELINES: dict[str, tuple[str, bool]] = {
@@ -68,7 +74,9 @@ BASELINES: dict[str, tuple[str, bool]] = {
 
 
 def folds(trials: Iterable[int], n_folds: int) -> list[list[int]]:
-    """Deal BROAD trials to ``n_folds`` test folds, undisturbed and disturbed separately
+    """Deal BROAD trials to ``n_folds`` test folds, each with both kinds of trial.
+
+    Deal BROAD trials to ``n_folds`` test folds, undisturbed and disturbed separately
     (in trial order), so that each fold has both kinds.
 
     Parameters
@@ -102,15 +110,18 @@ def folds(trials: Iterable[int], n_folds: int) -> list[list[int]]:
     return [sorted(f) for f in out]
 
 
-def trial_errors(q, recording) -> dict[str, float]:
-    """QAE (Eq. 4; mean and median, degrees) and BROAD's RMSEs of an estimate, over the
-    movement samples with a valid reference.
+@_deprecate.renamed(recording="rec")
+def trial_errors(q, rec) -> dict[str, float]:
+    """Score an estimate by QAE and BROAD's RMSEs over the movement samples.
+
+    QAE is Eq. 4 (mean and median, degrees), over the movement samples with a valid
+    reference.
 
     Parameters
     ----------
     q : array_like (N, 4)
-        Estimated unit quaternions (w, x, y, z), one per sample of ``recording``.
-    recording : xarray.Dataset
+        Estimated unit quaternions (w, x, y, z), one per sample of ``rec``.
+    rec : xarray.Dataset
         BROAD trial Recording with ``q_ref`` and ``movement``.
 
     Returns
@@ -119,10 +130,10 @@ def trial_errors(q, recording) -> dict[str, float]:
         ``qae_mean`` and ``qae_median`` (degrees), and BROAD's ``inclination``,
         ``heading`` and ``total`` RMSEs (degrees).
     """
-    e = evaluate.broad_errors(q, recording)
+    e = evaluate.broad_errors(q, rec)
     q = np.asarray(q, float)
-    ref = recording["q_ref"].transpose("time", "quat").values
-    mask = np.all(np.isfinite(ref), axis=1) & recording["movement"].values.astype(bool)
+    ref = rec["q_ref"].transpose("time", "quat").values
+    mask = np.all(np.isfinite(ref), axis=1) & rec["movement"].values.astype(bool)
     d = np.abs(np.sum(q[mask] * ref[mask], axis=1))
     qae_deg = np.degrees(np.arccos(np.clip(2 * d * d - 1, -1, 1)))
     return {
@@ -144,7 +155,9 @@ def cross_validate(
     command: str = "",
     progress: Callable[[str], None] = print,
 ) -> pd.DataFrame:
-    """Train one model per variant and fold, evaluate it on its held-out trials and
+    """Train one model per variant and fold and evaluate it on its held-out trials.
+
+    Train one model per variant and fold, evaluate it on its held-out trials and
     write the files listed in the module docstring to ``out``.
 
     Parameters
@@ -195,7 +208,7 @@ def cross_validate(
             history[f"{variant}/fold{k}"] = hist
             save(model, cfg, train_set[0].fs, out / f"{variant}_fold{k}.pt")
             for t in test:
-                q = run(model, seqs[t], cfg)
+                q = closed_loop_estimate(model, seqs[t], cfg)
                 rows.append(
                     {"variant": variant, "fold": k, "trial": t}
                     | trial_errors(q, recs[t])
@@ -259,7 +272,9 @@ def ablate(
     command: str = "",
     progress: Callable[[str], None] = print,
 ) -> pd.DataFrame:
-    """Train the quaternion variant once per entry of :data:`ABLATIONS` on one fold's
+    """Train and evaluate the quaternion variant once per entry of :data:`ABLATIONS`.
+
+    Train the quaternion variant once per entry of :data:`ABLATIONS` on one fold's
     training trials (``epochs`` epochs) and evaluate it, in closed loop, on that fold's
     test trials. Writes ``ablation.json`` to ``out``.
 
@@ -306,7 +321,10 @@ def ablate(
         cfg = TrainConfig.from_dict({**base.to_dict(), **change})
         progress(f"{name}")
         model, hist = train([seqs[t] for t in trials if t not in test], cfg)
-        errs = [trial_errors(run(model, seqs[t], cfg), recs[t]) for t in test]
+        errs = [
+            trial_errors(closed_loop_estimate(model, seqs[t], cfg), recs[t])
+            for t in test
+        ]
         qae_deg = float(np.mean([e["qae_mean"] for e in errs]))
         rows.append(
             {
@@ -385,13 +403,16 @@ def check_files(folder: str | Path) -> dict[str, str]:
     return out
 
 
-def learned_estimate(recording, weights: str | Path):
-    """Closed-loop estimate of a Recording by the model in ``weights`` (a ``.pt`` file
-    written by :func:`save`), labelled like :func:`tiltlab.filters.estimate`.
+@_deprecate.renamed(recording="rec")
+def learned_estimate(rec, weights: str | Path):
+    """Estimate the orientation of a Recording in closed loop with a saved model.
+
+    The model is the one in ``weights`` (a ``.pt`` file written by :func:`save`); the
+    result is labelled like :func:`tiltlab.filters.estimate`.
 
     Parameters
     ----------
-    recording : xarray.Dataset
+    rec : xarray.Dataset
         Recording to estimate, at the sampling rate the model was trained at.
     weights : str or pathlib.Path
         Model file (``.pt``) written by :func:`save`.
@@ -408,15 +429,15 @@ def learned_estimate(recording, weights: str | Path):
     """
     from ..filters import recordings as _rec
 
-    model, cfg, fs = load(weights)
-    seq = sequence(recording, acc_scale=cfg.acc_scale, mag_scale=cfg.mag_scale)
+    model, cfg, fs = load_model(weights)
+    seq = sequence(rec, acc_scale=cfg.acc_scale, mag_scale=cfg.mag_scale)
     if abs(seq.fs - fs) > 1e-6 * fs:
         raise ValueError(
             f"the model was trained at fs = {fs:.6g} Hz; the recording has "
             f"fs = {seq.fs:.6g} Hz (resample it, or train at its rate)"
         )
-    q = run(model, seq, cfg)
-    like = _rec.prepare(recording).like
+    q = closed_loop_estimate(model, seq, cfg)
+    like = _rec.prepare(rec).like
     return _v.labelled(
         quat.normalize(q),
         like,
@@ -441,12 +462,11 @@ def _compare_trial(folder: str, trial: int, fold: int, variants: list[str]):
     rec = datasets.load_broad_trial(trial)
     rows = []
     for v in variants:
-        model, cfg, _ = load(Path(folder) / f"{v}_fold{fold}.pt")
+        model, cfg, _ = load_model(Path(folder) / f"{v}_fold{fold}.pt")
         seq = sequence(rec, acc_scale=cfg.acc_scale, mag_scale=cfg.mag_scale)
+        q = closed_loop_estimate(model, seq, cfg)
         label = "CNN (quaternion)" if v == "quaternion" else "CNN (learned gain)"
-        rows.append(
-            {"method": label, "trial": trial} | trial_errors(run(model, seq, cfg), rec)
-        )
+        rows.append({"method": label, "trial": trial} | trial_errors(q, rec))
     for label, (method, use_mag) in BASELINES.items():
         q = filters.estimate(rec, method, use_mag=use_mag)
         errs = trial_errors(q.values, rec)
@@ -464,7 +484,9 @@ def compare(
     n_jobs: int = 1,
     progress: bool = False,
 ) -> pd.DataFrame:
-    """Every test trial of the committed folds: the CNN (both variants, each trial
+    """Compare the committed CNN folds with the baselines on every test trial.
+
+    Every test trial of the committed folds: the CNN (both variants, each trial
     estimated by the model of the fold that held it out) and the baselines of
     :data:`BASELINES` with their default parameters, all computed now.
 
@@ -514,4 +536,75 @@ def compare(
                 rows += part
                 bar.update()
     bar.close()
-    return pd.DataFrame(rows)
+    return _label_errors(pd.DataFrame(rows))
+
+
+def _label_errors(table: pd.DataFrame) -> pd.DataFrame:
+    """Attach units and long names to the error columns (and method, trial)."""
+    known = {"method": ("", "method"), "trial": ("", "BROAD trial")}
+    known |= {c: ("deg", name) for c, name in ERROR_COLUMNS.items()}
+    present = {c: v for c, v in known.items() if c in table.columns}
+    return label_columns(
+        table,
+        units={c: u for c, (u, _) in present.items()},
+        long_name={c: n for c, (_, n) in present.items()},
+    )
+
+
+def compare_summary(
+    table: pd.DataFrame,
+    *,
+    columns: Seq[str] = ("inclination", "heading", "total", "qae_mean"),
+    statistics: Seq[str] = ("mean", "median"),
+) -> pd.DataFrame:
+    """Summarise :func:`compare` per method, in the order the methods appear.
+
+    Parameters
+    ----------
+    table : pandas.DataFrame
+        Rows (method, trial) from :func:`compare`.
+    columns : sequence of str
+        Error columns to summarise (keys of :data:`ERROR_COLUMNS`).
+    statistics : sequence of str
+        Pandas aggregations, applied over trials (``"mean"``, ``"median"``…).
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per method, one column ``"<column> <statistic>"`` per pair, in
+        degrees, labelled (``attrs["units"]``, ``attrs["long_name"]``); a method
+        without a value (RIANN's heading) is NaN.
+
+    Examples
+    --------
+    >>> import pandas as pd
+    >>> from tiltlab import learn
+    >>> t = pd.DataFrame({"method": ["a", "a", "b"], "trial": [1, 2, 1],
+    ...                   "inclination": [1.0, 3.0, 2.0]})
+    >>> s = learn.compare_summary(t, columns=["inclination"], statistics=["mean"])
+    >>> s.to_dict()
+    {'inclination mean': {'a': 2.0, 'b': 2.0}}
+    >>> s.attrs["long_name"]["inclination mean"]
+    'inclination RMSE, mean over trials'
+    """
+    missing = [c for c in ("method", *columns) if c not in table.columns]
+    if missing:
+        raise ValueError(f"table has no column(s) {missing} (from learn.compare)")
+    unknown = [c for c in columns if c not in ERROR_COLUMNS]
+    if unknown:
+        raise ValueError(
+            f"unknown error column(s) {unknown}; known: {list(ERROR_COLUMNS)}"
+        )
+    methods = list(dict.fromkeys(table["method"]))
+    grouped = table.groupby("method", sort=False)
+    parts = {
+        f"{c} {stat}": grouped[c].agg(stat) for c in columns for stat in statistics
+    }
+    out = pd.DataFrame(parts).loc[methods]
+    out.index.name = "method"
+    names = {
+        f"{c} {stat}": f"{ERROR_COLUMNS[c]}, {stat} over trials"
+        for c in columns
+        for stat in statistics
+    }
+    return label_columns(out, units="deg", long_name=names)

@@ -30,12 +30,13 @@ from dataclasses import dataclass
 import numpy as np
 import xarray as xr
 
+from .. import _deprecate
 from .. import _validate as _v
 from .. import quaternion as quat
 from ..filters import recordings as _rec
 from ..filters.vectors import davenport, magnetic_dip
 
-__all__ = ["Sequence", "sequence"]
+__all__ = ["Sequence", "sequence", "window_ends"]
 
 
 @dataclass(frozen=True)
@@ -67,6 +68,7 @@ class Sequence:
     name: str
 
     def __len__(self) -> int:
+        """Count the samples."""
         return self.Q.shape[0]
 
 
@@ -76,17 +78,35 @@ def _still_dip(acc: np.ndarray, mag: np.ndarray, fs: float) -> float:
     return magnetic_dip(acc[:n], mag[:n])
 
 
+#: the sensors the learned estimators read, with their names in messages
+_NEEDED = (("gyr", "gyroscope"), ("mag", "magnetometer"))
+
+
+def _require_sensors(rec: xr.Dataset) -> None:
+    """Refuse a Recording without a gyroscope or magnetometer, naming the missing one."""
+    if not isinstance(rec, xr.Dataset):
+        return  # prepare() says what a Recording is
+    missing = [f"a {what} ('{var}')" for var, what in _NEEDED if var not in rec]
+    if missing:
+        raise _v.RecordingError(
+            f"the learned estimators need {' and '.join(missing)}: the recording has "
+            f"only {', '.join(map(repr, map(str, rec.data_vars))) or 'no variables'} "
+            "(an accelerometer-only recording cannot be used)"
+        )
+
+
+@_deprecate.renamed(recording="rec")
 def sequence(
-    recording: xr.Dataset,
+    rec: xr.Dataset,
     *,
     acc_scale: float = 9.81,
     mag_scale: float = 50.0,
 ) -> Sequence:
-    """Arrays of a Recording for training or running a learned estimator.
+    """Build the arrays of a Recording for training or running a learned estimator.
 
     Parameters
     ----------
-    recording : xarray.Dataset
+    rec : xarray.Dataset
         A Recording with ``acc``, ``gyr`` and ``mag`` (units in attrs, ``fs`` in
         attrs), optionally ``q_ref``.
     acc_scale : float
@@ -97,14 +117,18 @@ def sequence(
     Returns
     -------
     Sequence
+        The float32 arrays of the learned estimators' inputs.
+
+    Raises
+    ------
+    tiltlab._validate.RecordingError
+        A Recording without a gyroscope or a magnetometer (naming the missing
+        sensor), with non-finite samples or with time gaps.
     """
     acc_scale = _v.positive(acc_scale, "acc_scale")
     mag_scale = _v.positive(mag_scale, "mag_scale")
-    inputs = _rec.prepare(recording, use_mag=True)
-    if inputs.mag is None:
-        raise _v.RecordingError(
-            "the learned estimators need a magnetometer: the recording has no 'mag'"
-        )
+    _require_sensors(rec)
+    inputs = _rec.prepare(rec, use_mag=True)
     for name, arr in (("acc", inputs.acc), ("gyr", inputs.gyr), ("mag", inputs.mag)):
         if not np.all(np.isfinite(arr)):
             raise _v.RecordingError(
@@ -123,9 +147,9 @@ def sequence(
     dip = _still_dip(inputs.acc, inputs.mag, inputs.fs)
     q_vec = davenport(inputs.acc, inputs.mag, dip=dip)
     q_ref = None
-    if "q_ref" in recording:
-        q_ref = recording["q_ref"].transpose("time", "quat").values.astype(np.float32)
-    name = str(recording.attrs.get("trial", recording.attrs.get("session", "")))
+    if "q_ref" in rec:
+        q_ref = rec["q_ref"].transpose("time", "quat").values.astype(np.float32)
+    name = str(rec.attrs.get("trial", rec.attrs.get("session", "")))
     return Sequence(
         Q=Q.astype(np.float32),
         acc=(inputs.acc / acc_scale).astype(np.float32),
@@ -138,8 +162,22 @@ def sequence(
 
 
 def window_ends(seq: Sequence, window: int, stride: int = 1) -> np.ndarray:
-    """Indices ``t`` (every ``stride``-th) whose window ``t-window..t`` has a finite
-    reference at both ends (training targets and initial orientations).
+    """Find the window ends with a finite reference orientation at both ends.
+
+    Parameters
+    ----------
+    seq : Sequence
+        Arrays of a Recording with ``q_ref``.
+    window : int
+        Window length (samples).
+    stride : int
+        Keep every ``stride``-th end.
+
+    Returns
+    -------
+    numpy.ndarray
+        Indices ``t`` whose window ``t-window..t`` has a finite reference at both
+        ends (training targets and initial orientations).
     """
     window = int(_v.integer(window, "window", minimum=1))
     stride = int(_v.integer(stride, "stride", minimum=1))

@@ -98,10 +98,8 @@ def sample_loss(q_ref: torch.Tensor, q_est: torch.Tensor, kind: str) -> torch.Te
 
     Parameters
     ----------
-    q_ref : torch.Tensor (N, 4)
-        Reference unit quaternions (w, x, y, z).
-    q_est : torch.Tensor (N, 4)
-        Estimated unit quaternions (w, x, y, z), same shape as ``q_ref``.
+    q_ref, q_est : torch.Tensor (N, 4)
+        Reference and estimated unit quaternions (w, x, y, z), as for :func:`qae`.
     kind : str
         Loss name, one of ``"acos"``, ``"acos_taylor1"``, ``"acos_taylor2"``,
         ``"l1_product"``, ``"l2_product"`` (see :data:`LOSSES`).

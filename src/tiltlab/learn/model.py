@@ -102,7 +102,9 @@ class OrientationCNN(nn.Module):
     def forward(
         self, x: torch.Tensor, q_vec: torch.Tensor | None = None
     ) -> torch.Tensor:
-        """``x``: (B, 10, T) with the gyro quaternions in channels 0–3; ``q_vec``:
+        """Run the network on a batch of windows.
+
+        ``x``: (B, 10, T) with the gyro quaternions in channels 0–3; ``q_vec``:
         (B, 4), the vector-observation orientation at the window's end (``gain``
         variant only).
         """

@@ -1,4 +1,6 @@
-r"""Lookahead (Zhang et al. 2019) around any PyTorch optimiser; with
+r"""Wrap any PyTorch optimiser in Lookahead (Zhang et al. 2019).
+
+Lookahead (Zhang et al. 2019) around any PyTorch optimiser; with
 ``torch.optim.RAdam`` (Liu et al. 2020) inside it is the "RAdam + Lookahead" of Zaheer
 et al. (2023).
 
@@ -22,7 +24,9 @@ __all__ = ["Lookahead", "radam_lookahead"]
 
 
 class Lookahead:
-    """Lookahead wrapper: ``step()`` runs the inner optimiser and, every ``k`` calls,
+    """Wrap an optimiser in Lookahead.
+
+    Lookahead wrapper: ``step()`` runs the inner optimiser and, every ``k`` calls,
     the slow-weight update.
 
     Parameters
@@ -50,10 +54,12 @@ class Lookahead:
         ]
 
     def zero_grad(self, set_to_none: bool = True) -> None:
+        """Zero the inner optimiser's gradients."""
         self.inner.zero_grad(set_to_none=set_to_none)
 
     @torch.no_grad()
     def step(self) -> None:
+        """Step the inner optimiser; every ``k`` steps, update the slow weights."""
         self.inner.step()
         self._count += 1
         if self._count % self.k:

@@ -7,13 +7,14 @@ from collections.abc import Iterable, Mapping
 import pandas as pd
 import torch
 
+from .._labels import label_columns
 from .training import TrainConfig
 
 __all__ = ["layer_settings", "layer_table", "config_table"]
 
 
 def layer_settings(module: torch.nn.Module) -> str:
-    """The shape-defining settings of one layer, in words.
+    """Describe the shape-defining settings of one layer, in words.
 
     Parameters
     ----------
@@ -62,7 +63,7 @@ def layer_table(model: torch.nn.Module) -> pd.DataFrame:
     pandas.DataFrame
         Indexed by ``"layer"`` (the dotted module name), with the columns ``"type"``
         (class name), ``"settings"`` (:func:`layer_settings`) and ``"weights"``
-        (number of parameters, trainable or not).
+        (number of parameters, trainable or not), labelled (``attrs["long_name"]``).
 
     Examples
     --------
@@ -70,7 +71,7 @@ def layer_table(model: torch.nn.Module) -> pd.DataFrame:
     >>> layer_table(net)["weights"].tolist()
     [8, 0]
     """
-    return pd.DataFrame(
+    table = pd.DataFrame(
         [
             {
                 "layer": name,
@@ -83,6 +84,15 @@ def layer_table(model: torch.nn.Module) -> pd.DataFrame:
         ],
         columns=["layer", "type", "settings", "weights"],
     ).set_index("layer")
+    return label_columns(
+        table,
+        units={"type": "", "settings": "", "weights": "1"},
+        long_name={
+            "type": "layer type",
+            "settings": "settings",
+            "weights": "weights (parameters)",
+        },
+    )
 
 
 def _setting(v) -> str:
@@ -97,7 +107,7 @@ def config_table(
     *,
     skip: Iterable[str] = ("variant", "threads", "seed"),
 ) -> pd.DataFrame:
-    """The settings of a training configuration, one row each, with what they mean.
+    """Tabulate the settings of a training configuration, with what they mean.
 
     Parameters
     ----------
@@ -113,7 +123,7 @@ def config_table(
     pandas.DataFrame
         Indexed by ``"setting"`` (in :meth:`TrainConfig.to_dict` order), with the
         columns ``"meaning"`` and ``"value"`` (a string: sequences joined by ``", "``,
-        floats in ``%g``).
+        floats in ``%g``), labelled (``attrs["long_name"]``).
 
     Examples
     --------
@@ -129,7 +139,7 @@ def config_table(
         raise ValueError(
             f"not settings of a TrainConfig: {sorted(unknown)}; they are {list(fields)}"
         )
-    return pd.DataFrame(
+    table = pd.DataFrame(
         [
             {"setting": k, "meaning": meanings.get(k, ""), "value": _setting(v)}
             for k, v in fields.items()
@@ -137,3 +147,8 @@ def config_table(
         ],
         columns=["setting", "meaning", "value"],
     ).set_index("setting")
+    return label_columns(
+        table,
+        units={"meaning": "", "value": ""},
+        long_name={"meaning": "meaning", "value": "value"},
+    )

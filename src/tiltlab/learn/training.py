@@ -1,4 +1,6 @@
-r"""Training, closed-loop inference and grouped cross-validation of the learned
+r"""Train the learned orientation estimators and run them in closed loop.
+
+Training, closed-loop inference and grouped cross-validation of the learned
 orientation estimators.
 
 Everything is seeded and runs deterministically on the CPU
@@ -34,7 +36,9 @@ from typing import Any
 import numpy as np
 import torch
 
+from .. import _deprecate
 from .. import _validate as _v
+from ..datasets import file_sha256
 from ..io import IntegrityError
 from .data import Sequence, window_ends
 from .losses import LOSSES, TOTALS, qae, qmul, sample_loss, total_loss
@@ -45,8 +49,10 @@ __all__ = [
     "TrainConfig",
     "build_model",
     "train",
+    "closed_loop_estimate",
     "run",
     "save",
+    "load_model",
     "load",
     "sha256",
     "read_sums",
@@ -88,6 +94,7 @@ class TrainConfig:
     threads: int = 1
 
     def __post_init__(self):
+        """Check every field."""
         if self.variant not in ("quaternion", "gain"):
             raise ValueError(
                 f"variant must be 'quaternion' or 'gain', got {self.variant!r}"
@@ -114,13 +121,16 @@ class TrainConfig:
         object.__setattr__(self, "activations", tuple(self.activations))
 
     def window(self, fs: float) -> int:
+        """Return the window length in samples at the sampling rate ``fs`` (Hz)."""
         return int(round(self.window_s * _v.check_fs(fs)))
 
     def to_dict(self) -> dict[str, Any]:
+        """Return the configuration as a JSON-able dict."""
         return dataclasses.asdict(self)
 
     @classmethod
     def from_dict(cls, d: dict[str, Any]) -> TrainConfig:
+        """Build a configuration from :meth:`to_dict` output."""
         d = dict(d)
         d["dilations"] = tuple(d["dilations"])
         d["activations"] = tuple(d["activations"])
@@ -128,7 +138,7 @@ class TrainConfig:
 
 
 def build_model(config: TrainConfig, fs: float) -> OrientationCNN:
-    """A new (untrained) network for a configuration and sampling rate.
+    """Build a new (untrained) network for a configuration and sampling rate.
 
     Parameters
     ----------
@@ -209,7 +219,9 @@ def _inputs(
     q0: torch.Tensor,
     window: int,
 ) -> torch.Tensor:
-    """(B, 10, T) network inputs for windows ending at ``ends`` (windowed ``acc_w`` and
+    """Assemble the (B, 10, T) network inputs of windows ending at ``ends``.
+
+    (B, 10, T) network inputs for windows ending at ``ends`` (windowed ``acc_w`` and
     ``mag_w``, (B, T, 3)) from initial orientations ``q0`` (B, 4) at ``ends - window``.
     """
     dq = qmul(_conj(Q[ends - window])[:, None, :], Q[_indices(ends, window)])
@@ -280,6 +292,9 @@ def train(
     sequences : sequence of Sequence
         Training data (:func:`tiltlab.learn.sequence`), all at the same ``fs``.
     config : TrainConfig
+        Model and training settings: the architecture and window (``window_s``, s),
+        ``epochs``, ``batch``, ``stride``, ``lr`` and Lookahead settings, the loss, the
+        augmentation noise and biases, ``seed`` and ``threads``.
     max_steps : int, optional
         Stop after this many optimiser steps (tests, quick looks).
     progress : callable, optional
@@ -356,8 +371,10 @@ def train(
 
 
 @torch.no_grad()
-def run(model: OrientationCNN, seq: Sequence, config: TrainConfig) -> np.ndarray:
-    r"""Closed-loop estimate of a whole sequence, (N, 4) float64.
+def closed_loop_estimate(
+    model: OrientationCNN, seq: Sequence, config: TrainConfig
+) -> np.ndarray:
+    r"""Estimate the orientation of a whole sequence in closed loop, (N, 4) float64.
 
     The first :math:`T` samples integrate the gyroscope from the vector-observation
     orientation of the first window (QUEST initialisation); from then on, the estimate
@@ -428,11 +445,7 @@ def sha256(path: str | Path) -> str:
     str
         Hex digest (64 lower-case characters).
     """
-    h = hashlib.sha256()
-    with open(path, "rb") as f:
-        for chunk in iter(lambda: f.read(1 << 20), b""):
-            h.update(chunk)
-    return h.hexdigest()
+    return file_sha256(path)
 
 
 #: Name of the checksum file of a model folder (``sha256sum`` format).
@@ -506,7 +519,9 @@ def read_sums(path: str | Path) -> dict[str, str]:
 
 
 def _state_digest(blob: dict[str, Any]) -> str:
-    """SHA-256 of what a model file holds: configuration, ``fs`` and every tensor's
+    """Hash what a model file holds with SHA-256.
+
+    SHA-256 of what a model file holds: configuration, ``fs`` and every tensor's
     name, dtype, shape and bytes.
     """
     h = hashlib.sha256()
@@ -529,7 +544,7 @@ def save(
     """Write the weights (``path``, a ``.pt`` state dict) and return their sha256.
 
     The file also holds the SHA-256 of its content (configuration, ``fs``, every
-    tensor), which :func:`load` checks; the returned sha256 of the whole file is the
+    tensor), which :func:`load_model` checks; the returned sha256 of the whole file is the
     one to list in the folder's ``SHA256SUMS`` (:func:`tiltlab.learn.cross_validate`
     does).
 
@@ -557,12 +572,13 @@ def save(
     return sha256(path)
 
 
-def load(
+def load_model(
     path: str | Path, *, sha256: str | None = None, verify: bool = True
 ) -> tuple[OrientationCNN, TrainConfig, float]:
-    """Read weights written by :func:`save`: the model (evaluation mode), its
-    configuration and the sampling rate it was trained at.
+    """Read weights written by :func:`save`.
 
+    Gives the model (evaluation mode), its configuration and the sampling rate it was
+    trained at.
     The file is checked first against its recorded sha256: ``sha256`` if given, else
     its entry in ``SHA256SUMS`` beside it (the committed models, :func:`cross_validate`
     folders); then against the digest of its content stored by :func:`save`. A file
@@ -608,7 +624,7 @@ def load(
                 raise IntegrityError(
                     f"{path}: model weights refused, sha256 {got} differs from "
                     f"{source} ({expected}): the file is corrupt or was altered "
-                    "(load(path, verify=False) reads it anyway, to inspect it)",
+                    "(load_model(path, verify=False) reads it anyway, to inspect it)",
                     path=path,
                 )
     try:
@@ -625,7 +641,7 @@ def load(
         raise IntegrityError(
             f"{path}: model weights refused, their content differs from the sha256 "
             "saved with them: the file is corrupt or was altered "
-            "(load(path, verify=False) reads it anyway, to inspect it)",
+            "(load_model(path, verify=False) reads it anyway, to inspect it)",
             path=path,
         )
     if verify and stored is None and expected is None:
@@ -641,8 +657,21 @@ def load(
     return model, cfg, float(blob["fs"])
 
 
-_file_sha256 = sha256  # ``load`` has a parameter of that name
+_file_sha256 = sha256  # ``load_model`` has a parameter of that name
+
+#: the old names, for one release
+run = _deprecate.alias(closed_loop_estimate, "run")
+load = _deprecate.alias(load_model, "load")
 
 
 def write_json(obj: Any, path: str | Path) -> None:
+    """Write ``obj`` as indented JSON with sorted keys and a final newline.
+
+    Parameters
+    ----------
+    obj : object
+        JSON-serialisable value.
+    path : str or pathlib.Path
+        File written.
+    """
     Path(path).write_text(json.dumps(obj, indent=1, sort_keys=True) + "\n")

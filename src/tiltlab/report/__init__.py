@@ -1,4 +1,6 @@
-"""Your book on your data in one command: chosen chapters, executed on your recording or
+"""Run your book on your data in one command.
+
+Your book on your data in one command: chosen chapters, executed on your recording or
 cohort, rendered as HTML with the book's look.
 
 :func:`run_report` executes chapters of the book (the ``NN_*.ipynb`` notebooks of a
@@ -19,7 +21,7 @@ Which parameter receives the source:
   ``RAT_SOURCE`` in chapter 4 (its ``SOURCE`` needs a ground truth);
 * a cohort manifest (a CSV read by :func:`tiltlab.cohort.read_manifest`) goes to
   ``COHORT_MANIFEST`` (chapter 8). With a manifest, the recording chapters run only on
-  a recording given as well (``recording=``, ``--recording``); otherwise they are
+  a recording given as well (``recording_path=``, ``--recording``); otherwise they are
   listed as not run, with the reason, as chapter 8 is for a recording.
 
 Chapters run with their own folder as the working directory, as in the book build.
@@ -34,6 +36,7 @@ from collections.abc import Iterable, Mapping
 from pathlib import Path
 from typing import Any
 
+from .._deprecate import renamed
 from ._plan import (
     ChapterResult,
     ReportError,
@@ -80,6 +83,7 @@ def _prepare_out(out: Path) -> None:
     (out / "notebooks").mkdir(parents=True, exist_ok=True)
 
 
+@renamed(recording="recording_path")
 def run_report(
     source: str | os.PathLike,
     chapters: str | Iterable[int] | None,
@@ -87,7 +91,7 @@ def run_report(
     *,
     params: Mapping[str, Any] | None = None,
     book_dir: str | os.PathLike | None = None,
-    recording: str | os.PathLike | None = None,
+    recording_path: str | os.PathLike | None = None,
     render: bool = True,
     progress: bool = True,
 ) -> ReportResult:
@@ -123,7 +127,7 @@ def run_report(
     book_dir : str or path-like, optional
         The chapters' folder (see :func:`find_chapters`; default
         ``TILTLAB_BOOK_DIR``, else the checkout's ``notebooks/``).
-    recording : str or path-like, optional
+    recording_path : str or path-like, optional
         With a manifest as ``source``: a recording for the chapters that analyse one.
     render : bool, default True
         Build the HTML pages (False: only execute, e.g. in tests).
@@ -171,12 +175,12 @@ def run_report(
     chosen = [available[n] for n in parse_chapters(chapters, available)]
     src = _classify(source)
     rec = None
-    if recording is not None:
+    if recording_path is not None:
         if src.kind != "manifest":
             raise ReportError(
                 "--recording goes with a cohort manifest; the source is a recording"
             )
-        rec = _classify(recording, what="--recording")
+        rec = _classify(recording_path, what="--recording")
     user = {k: _absolute_if_file(v) for k, v in (params or {}).items()}
     unknown = [k for k in user if not any(k in ch.parameters for ch in chosen)]
     if unknown:

@@ -18,7 +18,7 @@ from ._plan import (
 
 
 def _skipped_lines(notebook: Path) -> list[str]:
-    """Printed lines (stream outputs) containing "skipped", in order, without repeats."""
+    """Collect printed lines containing "skipped", in order, without repeats."""
     try:
         nb = json.loads(notebook.read_text(encoding="utf-8"))
     except (OSError, ValueError):

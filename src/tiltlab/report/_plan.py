@@ -1,4 +1,6 @@
-"""What a report runs: the book's chapters, the source's kind, and which parameter
+"""Plan a report: the chapters, the source's kind and the parameter that gets it.
+
+What a report runs: the book's chapters, the source's kind, and which parameter
 of each chapter receives it; the records of what ran.
 """
 
@@ -44,7 +46,9 @@ Status = Literal["ran", "failed", "not run"]
 
 
 class ReportError(ValueError):
-    """A report that cannot start (a bad source, chapter list, parameter, book folder
+    """Signal a report that cannot start or whose pages cannot be rendered.
+
+    A report that cannot start (a bad source, chapter list, parameter, book folder
     or output folder) or whose pages cannot be rendered; the message says what to do.
     """
 
@@ -164,7 +168,7 @@ def _default_book_dir() -> tuple[Path, str]:
 
 
 def find_chapters(book_dir: str | os.PathLike | None = None) -> Path:
-    """The folder of the book's chapters (``NN_*.ipynb``).
+    """Find the folder of the book's chapters (``NN_*.ipynb``).
 
     Parameters
     ----------
@@ -337,7 +341,9 @@ def _source_parameters(
 def _plan(
     ch: _Chapter, source: _Source, recording: _Source | None, given: Iterable[str]
 ) -> tuple[dict[str, Any], str | None]:
-    """The source parameters of one chapter, or why it does not run (a chapter whose
+    """Find the source parameters of one chapter, or why it does not run.
+
+    The source parameters of one chapter, or why it does not run (a chapter whose
     source parameter the user gave, ``given``, runs with it).
     """
     rec_names = _source_parameters(ch, RECORDING_PARAMETERS, _RECORDING_DEFAULT)
@@ -347,27 +353,32 @@ def _plan(
             return dict.fromkeys(man_names, source.value), None
         if rec_names and recording is not None:
             return dict.fromkeys(rec_names, recording.value), None
-        if set(rec_names) & set(given):
-            return {}, None
-        if rec_names:
-            return {}, (
+        wanted, why = (
+            rec_names,
+            (
                 f"chapter {ch.number} analyses one recording and {source.label} is a "
                 "cohort manifest: give one of its recordings as well (--recording FILE)"
-            )
+            ),
+        )
     elif rec_names:
         return dict.fromkeys(rec_names, source.value), None
-    elif set(man_names) & set(given):
-        return {}, None
-    elif man_names:
-        return {}, (
-            f"chapter {ch.number} analyses a cohort and {source.label} is one "
-            "recording: give a cohort manifest (.csv; 'tiltlab cohort init' writes one)"
+    else:
+        wanted, why = (
+            man_names,
+            (
+                f"chapter {ch.number} analyses a cohort and {source.label} is one "
+                "recording: give a cohort manifest (.csv; 'tiltlab cohort init' writes one)"
+            ),
         )
+    if wanted:  # the chapter runs when the user gave its source parameter
+        return {}, None if set(wanted) & set(given) else why
     return {}, f"chapter {ch.number} has no parameter for a recording or a manifest"
 
 
 def _absolute_if_file(value: Any) -> Any:
-    """A relative path to an existing file or folder, made absolute (chapters run in
+    """Make a relative path to an existing file or folder absolute.
+
+    A relative path to an existing file or folder, made absolute (chapters run in
     their own folder); any other value as it is.
     """
     if isinstance(value, str) and value and not os.path.isabs(value):

@@ -1,4 +1,6 @@
-"""The report's pages: an index, the executed chapters and the book's look, built with
+"""Build the report's pages with jupyter-book.
+
+The report's pages: an index, the executed chapters and the book's look, built with
 jupyter-book.
 """
 
@@ -141,7 +143,7 @@ def _summary_json(result: ReportResult) -> str:
 
 
 def _book_config_dir(chapters_dir: Path) -> Path | None:
-    """The ``book/`` folder beside the chapters (its ``_config.yml``), if any."""
+    """Find the ``book/`` folder beside the chapters (its ``_config.yml``), if any."""
     for candidate in (chapters_dir.parent / "book", chapters_dir.parent):
         if (candidate / "_config.yml").is_file():
             return candidate
@@ -179,7 +181,9 @@ def _config(book: Path | None, title: str) -> dict[str, Any]:
 def _copy_book_files(
     book: Path | None, dest: Path, config: dict[str, Any]
 ) -> list[str]:
-    """Copy what the configuration names (style, extension, bibliography, vendored
+    """Copy what the configuration names and the reference pages.
+
+    Copy what the configuration names (style, extension, bibliography, vendored
     MathJax) and the reference pages; return the pages copied.
     """
     if book is None:
@@ -209,7 +213,9 @@ _DOC_ROLE = re.compile(r"\{doc\}`([^`<]*?)\s*(?:<([^`>]+)>)?`")
 
 
 def _unlink(text: str, keep: set[str], titles: Mapping[str, str]) -> str:
-    """``{doc}`` references to pages the report does not have (the chapters not run, a
+    """Render references to pages the report does not have as plain text.
+
+    ``{doc}`` references to pages the report does not have (the chapters not run, a
     reference page not copied) as plain text: the label, or the chapter's title.
     """
 
@@ -232,7 +238,9 @@ def _page_copy(
     keep: set[str],
     titles: Mapping[str, str],
 ) -> None:
-    """The executed notebook as a page of the report: its number before its title (the
+    """Turn an executed notebook into a page of the report.
+
+    The executed notebook as a page of the report: its number before its title (the
     report's pages are not numbered by position, as the book's are), and references to
     pages the report lacks as plain text.
     """
