@@ -5,15 +5,15 @@ same BROAD trial (trial 2: 53,240 samples at 285.7 Hz).
 What is timed (median wall time of ``--repeat`` calls, after an untimed warm-up on the
 trial's first samples; samples/s; ratio = how many times slower than Mahony 9D):
 
-* Mahony 9D, ESKF 9D, VQF 9D: ``tiltlab.filters.run(method, inputs)`` on inputs read
+* Mahony 9D, ESKF 9D, VQF 9D: ``tiltlab.filters.run_method(method, inputs)`` on inputs read
   once by ``tiltlab.filters.prepare(rec, use_mag=True)`` (as bench_filters.py: reading
   the Recording is not timed);
-* RIANN 6D: ``tiltlab.filters.run("riann", inputs_6d)`` (onnxruntime with its default
+* RIANN 6D: ``tiltlab.filters.run_method("riann", inputs_6d)`` (onnxruntime with its default
   threads; each call also creates the ONNX session, as ``filters.estimate`` does);
 * CNN input: ``tiltlab.learn.sequence(rec)`` (reads the Recording, integrates the gyro,
   Davenport orientation of every sample), timed on its own;
 * CNN (quaternion) and CNN (learned gain): the closed-loop network loop
-  ``tiltlab.learn.run(model, seq, cfg)``, with ``torch.set_num_threads(1)`` and ``(2)``.
+  ``tiltlab.learn.closed_loop_estimate(model, seq, cfg)``, with ``torch.set_num_threads(1)`` and ``(2)``.
   The end to end cost of a CNN is its input row plus its loop row (printed below the
   table).
 
@@ -76,7 +76,7 @@ def model_for(variant: str, rec):
     for folder in MODEL_DIRS:
         path = folder / f"{variant}_fold0.pt"
         if path.is_file():
-            model, cfg, _ = L.load(path)
+            model, cfg, _ = L.load_model(path)
             return model, cfg, str(path)
     cfg = L.TrainConfig(variant=variant, epochs=1)
     seq = L.sequence(rec, acc_scale=cfg.acc_scale, mag_scale=cfg.mag_scale)
@@ -126,8 +126,8 @@ def main() -> None:
     inputs = {True: F.prepare(rec, use_mag=True), False: F.prepare(rec)}
     for label, method, use_mag in FILTERS:
         x = inputs[use_mag]
-        F.run(method, head(x, WARMUP))  # warm-up (numba compile / cache load)
-        rows.append((label, "-", median_of(lambda: F.run(method, x), repeat)))
+        F.run_method(method, head(x, WARMUP))  # warm-up (numba compile / cache load)
+        rows.append((label, "-", median_of(lambda: F.run_method(method, x), repeat)))
 
     # ---- CNN: input preparation, then the closed-loop network loop
     seqs = {}
@@ -143,8 +143,8 @@ def main() -> None:
         seq = seqs[key]
         for threads in args.threads:
             torch.set_num_threads(threads)
-            L.run(model, head(seq, WARMUP), cfg)  # warm-up
-            t = median_of(lambda: L.run(model, seq, cfg), repeat)
+            L.closed_loop_estimate(model, head(seq, WARMUP), cfg)  # warm-up
+            t = median_of(lambda: L.closed_loop_estimate(model, seq, cfg), repeat)
             rows.append((VARIANTS[variant], str(threads), t))
 
     t_mahony = rows[0][2]

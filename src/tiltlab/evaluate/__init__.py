@@ -1,5 +1,6 @@
-r"""Evaluation of tilt estimates: per-sample errors, Table-1 statistics, error versus
-angular speed, empirical CDFs, per-trial error tables and leave-one-trial-out (LOTO)
+r"""Evaluation of tilt estimates against a reference, and parameter selection.
+
+Per-sample errors, Table-1 statistics, error versus angular speed, empirical CDFs, per-trial error tables and leave-one-trial-out (LOTO)
 parameter selection.
 
 Error definitions
@@ -44,9 +45,11 @@ the tilt difference between two methods, errors pooled over recordings) and
 :mod:`~tiltlab.evaluate.mocap` (the motion-capture reference).
 """
 
+import warnings as _warnings
+
 from .errors import (
     FAYAT_TABLE1,
-    STATES,
+    MOTION_STATES,
     STATISTICS,
     binned_by_speed,
     broad_errors,
@@ -65,30 +68,27 @@ from .mocap import mocap_reference
 from .recipes import best_params, estimator, pooled_errors, tilt_difference_rms
 from .selection import error_table, grid_search, loto, loto_summary, optimum
 
+from .errors import __all__ as _errors_all
+from .mocap import __all__ as _mocap_all
+from .recipes import __all__ as _recipes_all
+from .selection import __all__ as _selection_all
+
 __all__ = [
-    "STATES",
-    "STATISTICS",
-    "FAYAT_TABLE1",
-    "shift_quaternions",
-    "shifted_score",
-    "tilt_errors",
-    "error_stats",
-    "error_summary",
-    "table1",
-    "state_scores",
-    "binned_by_speed",
-    "ecdf",
-    "broad_errors",
-    "tilt_rmse",
-    "grid_search",
-    "optimum",
-    "loto",
-    "error_table",
-    "loto_summary",
-    "best_params",
-    "estimator",
-    "tilt_difference_rms",
-    "pooled_errors",
-    "pairwise_tilt_rms",
-    "mocap_reference",
+    *_errors_all,
+    *_selection_all,
+    *_recipes_all,
+    *_mocap_all,
 ]
+
+
+def __getattr__(name: str):
+    """Return ``STATES``, the old name of :data:`MOTION_STATES`, with a warning."""
+    if name == "STATES":
+        _warnings.warn(
+            "tiltlab.evaluate.STATES was renamed MOTION_STATES (tiltlab.simulate.STATES "
+            "is another thing); the old name goes in the next release",
+            FutureWarning,
+            stacklevel=2,
+        )
+        return MOTION_STATES
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -1,4 +1,6 @@
-r"""Error definitions and statistics: per-sample tilt errors, BROAD's RMSEs, Fayat's
+r"""Error definitions and statistics of tilt estimates.
+
+Per-sample tilt errors, BROAD's RMSEs, Fayat's
 Table-1 statistics, error versus angular speed, empirical CDFs and agreement between
 estimates.
 """
@@ -13,9 +15,10 @@ import pandas as pd
 import xarray as xr
 
 from .. import quaternion as quat
+from .._labels import label_columns
 
 __all__ = [
-    "STATES",
+    "MOTION_STATES",
     "STATISTICS",
     "FAYAT_TABLE1",
     "shift_quaternions",
@@ -33,7 +36,7 @@ __all__ = [
 ]
 
 #: Behavioural states of Table 1 (plus ``all`` in :func:`state_scores`).
-STATES = ("immobile", "moving")
+MOTION_STATES = ("immobile", "moving")
 #: Statistics of Table 1, in order.
 STATISTICS = ("mean", "std", "median", "q25", "q75", "q95")
 
@@ -56,6 +59,30 @@ FAYAT_TABLE1 = pd.DataFrame(
     index=pd.Index(STATISTICS, name="statistic"),
 )
 FAYAT_TABLE1.columns.names = ["state", "method"]
+
+#: Long names of the statistics of Table 1 and of :func:`error_stats`.
+STATISTIC_NAMES = {
+    "mean": "mean",
+    "std": "standard deviation",
+    "median": "median",
+    "q25": "25th percentile",
+    "q75": "75th percentile",
+    "q95": "95th percentile",
+    "rmse": "RMS",
+    "n": "samples",
+}
+
+
+def _label_table1(df: pd.DataFrame) -> pd.DataFrame:
+    """Table 1 with its columns labelled: tilt errors in degrees, by state and method."""
+    return label_columns(
+        df,
+        units="deg",
+        long_name={c: f"tilt error, {c[0]}, {c[1]}" for c in df.columns},
+    )
+
+
+FAYAT_TABLE1 = _label_table1(FAYAT_TABLE1)
 
 
 def _quat_array(q, name: str) -> np.ndarray:
@@ -118,6 +145,18 @@ def tilt_errors(q_est, ref) -> np.ndarray:
     -------
     numpy.ndarray, shape (N,)
         :math:`\arccos(\hat g \cdot g_{ref})` in degrees.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from tiltlab import evaluate
+    >>> level = [1.0, 0.0, 0.0, 0.0]
+    >>> half = np.radians(5.0) / 2  # 5° about x
+    >>> tipped = [np.cos(half), np.sin(half), 0.0, 0.0]
+    >>> np.round(evaluate.tilt_errors([level, tipped], [level, level]), 3)
+    array([0., 5.])
+    >>> np.round(evaluate.tilt_errors([tipped], [[0.0, 0.0, 1.0]]), 3)  # gravity-up ref
+    array([5.])
     """
     q = _quat_array(q_est, "q_est")
     r = ref.values if isinstance(ref, xr.DataArray) else np.asarray(ref, dtype=float)
@@ -167,8 +206,13 @@ def broad_errors(
     Parameters
     ----------
     q_est : xarray.DataArray or array_like, shape (N, 4)
+        Estimated unit quaternions (w, x, y, z), one per sample of ``rec``.
     rec : xarray.Dataset
         Recording with ``q_ref`` (and ``movement``).
+    movement_only : bool
+        Score only the samples where the Recording's boolean ``movement`` variable is
+        true (BROAD's rule; a ``ValueError`` if it has none); False scores every
+        sample with a finite estimate and reference.
     remove_heading_offset : bool
         Remove the constant heading offset between the estimate's and the reference's
         world frames first (circular mean over the valid samples). BROAD does not do
@@ -219,10 +263,8 @@ def tilt_rmse(q_est, rec: xr.Dataset) -> float:
 
     Parameters
     ----------
-    q_est : xarray.DataArray or array_like, shape (N, 4)
-        Estimated unit quaternions (w, x, y, z), one per sample of ``rec``.
-    rec : xarray.Dataset
-        Recording with ``q_ref`` (and ``movement``).
+    q_est, rec
+        As for :func:`broad_errors` (estimate and Recording with ``q_ref``).
 
     Returns
     -------
@@ -235,8 +277,9 @@ def tilt_rmse(q_est, rec: xr.Dataset) -> float:
 def shifted_score(
     shifts: Sequence[float], score_fn: Callable[[Any, xr.Dataset], float] | None = None
 ) -> Callable[[Any, xr.Dataset], xr.DataArray]:
-    """A ``score_fn`` for :func:`grid_search` that scores the estimate at
-    several time shifts (:func:`shift_quaternions`, in samples): returns a DataArray over
+    """Make a ``score_fn`` for :func:`grid_search` that scores at several time shifts.
+
+    It scores the estimate at several time shifts (:func:`shift_quaternions`, in samples): returns a DataArray over
     ``shift``, so that the shift is one more dimension of the grid (and of LOTO selection).
     The same shifts must be applied to every method compared.
 
@@ -263,20 +306,29 @@ def shifted_score(
     if sh.size == 0 or not np.all(np.isfinite(sh)):
         raise ValueError("shifts must be a non-empty sequence of finite numbers")
     fn = score_fn or tilt_rmse
+    attrs = {"units": "deg", "long_name": "tilt RMSE"} if fn is tilt_rmse else {}
 
     def score(q, rec):
         return xr.DataArray(
             [float(fn(shift_quaternions(q, d), rec)) for d in sh],
             dims=("shift",),
-            coords={"shift": sh},
+            coords={
+                "shift": (
+                    "shift",
+                    sh,
+                    {"units": "1", "long_name": "time shift (samples)"},
+                )
+            },
+            attrs=attrs,
         )
 
     return score
 
 
 def error_stats(errors, mask=None) -> dict[str, float]:
-    """Table-1 statistics (mean, std, median, Q25, Q75, Q95) of finite errors, plus ``n``
-    and ``rmse``; ``mask`` selects samples. NaN statistics when nothing is selected.
+    """Compute the Table-1 statistics of finite errors.
+
+    Mean, std, median, Q25, Q75, Q95, plus ``n`` and ``rmse``; ``mask`` selects samples. NaN statistics when nothing is selected.
 
     Parameters
     ----------
@@ -351,7 +403,8 @@ def error_summary(
         Index ``method``; columns ``rmse``, ``mean``, ``median``, ``q95`` (degrees) and
         ``n`` (samples scored). With ``ref="q_ref"`` and ``mask="movement"``, ``rmse`` is
         BROAD's inclination RMSE (:func:`tilt_rmse`). ``attrs["mask"]`` names the mask
-        used (``None`` when all samples were scored).
+        used (``None`` when all samples were scored); ``attrs["units"]`` and
+        ``attrs["long_name"]`` label the columns.
 
     Raises
     ------
@@ -373,8 +426,15 @@ def error_summary(
     df = pd.DataFrame.from_dict(rows, orient="index")
     df.index.name = "method"
     df["n"] = df["n"].astype(int)
+    df = label_columns(
+        df,
+        units={c: "1" if c == "n" else "deg" for c in df.columns},
+        long_name={
+            c: "samples scored" if c == "n" else f"tilt error, {STATISTIC_NAMES[c]}"
+            for c in df.columns
+        },
+    )
     df.attrs["mask"] = used
-    df.attrs["units"] = "deg"
     return df
 
 
@@ -390,12 +450,16 @@ def table1(
         reference). Several sessions may be concatenated.
     immobile : array_like of bool
         Immobility mask of the same length.
+    statistics : sequence of str
+        Rows of the table, in order: names of :data:`STATISTICS` (the default, all of
+        them), ``"rmse"`` or ``"n"`` (samples used).
 
     Returns
     -------
     pandas.DataFrame
         Index ``statistic``; columns MultiIndex (``state`` ∈ immobile, moving;
-        ``method``), like :data:`FAYAT_TABLE1`.
+        ``method``), like :data:`FAYAT_TABLE1`; values in degrees, columns labelled
+        (``attrs["units"]``, ``attrs["long_name"]``).
     """
     if not errors:
         raise ValueError("errors is empty")
@@ -417,7 +481,7 @@ def table1(
             cols[(state, name)] = [st[s] for s in statistics]
     df = pd.DataFrame(cols, index=pd.Index(list(statistics), name="statistic"))
     df.columns.names = ["state", "method"]
-    return df
+    return _label_table1(df)
 
 
 def state_scores(
@@ -428,8 +492,9 @@ def state_scores(
     state: str = "immobile",
     stat: str = "mean",
 ) -> xr.DataArray:
-    """Tilt-error statistic per behavioural state: a DataArray-valued ``score_fn`` for
-    :func:`grid_search` (dims ``state`` = immobile, moving, all).
+    """Compute a tilt-error statistic per behavioural state.
+
+    A DataArray-valued ``score_fn`` for :func:`grid_search` (dims ``state`` = immobile, moving, all).
 
     Parameters
     ----------
@@ -438,6 +503,12 @@ def state_scores(
     rec : xarray.Dataset
         Recording with the reference ``ref`` (quaternions (time, quat) or gravity-up
         directions (time, axis)) and a boolean ``state`` variable (True = immobile).
+    ref : str
+        Name of the Recording's reference variable the tilt errors are computed
+        against (default ``"tilt_ref"``).
+    state : str
+        Name of the Recording's boolean variable that is True on immobile samples
+        (default ``"immobile"``); the other samples count as moving.
     stat : str
         One of :data:`STATISTICS` or ``"rmse"``.
 
@@ -460,7 +531,10 @@ def state_scores(
     im = rec[state].values.astype(bool)
     vals = [error_stats(e, im)[stat], error_stats(e, ~im)[stat], error_stats(e)[stat]]
     return xr.DataArray(
-        vals, dims=("state",), coords={"state": ["immobile", "moving", "all"]}
+        vals,
+        dims=("state",),
+        coords={"state": ["immobile", "moving", "all"]},
+        attrs={"units": "deg", "long_name": f"tilt error, {STATISTIC_NAMES[stat]}"},
     )
 
 
@@ -516,12 +590,23 @@ def binned_by_speed(errors: Mapping[str, Any], speed, edges) -> xr.Dataset:
     )  # not "method": it would clash with the ``method`` argument of ``.sel``
     coords = {
         "estimator": names,
-        "speed": 0.5 * (edges[:-1] + edges[1:]),
-        "speed_lo": ("speed", edges[:-1]),
-        "speed_hi": ("speed", edges[1:]),
+        "speed": (
+            "speed",
+            0.5 * (edges[:-1] + edges[1:]),
+            {"units": "deg/s", "long_name": "angular speed, bin centre"},
+        ),
+        "speed_lo": ("speed", edges[:-1], {"units": "deg/s"}),
+        "speed_hi": ("speed", edges[1:], {"units": "deg/s"}),
     }
+    names = {k: f"tilt error, {STATISTIC_NAMES[k]}" for k in out}
     return xr.Dataset(
-        {**{k: (dims, v, {"units": "deg"}) for k, v in out.items()}, "n": (dims, cnt)},
+        {
+            **{
+                k: (dims, v, {"units": "deg", "long_name": names[k]})
+                for k, v in out.items()
+            },
+            "n": (dims, cnt, {"units": "1", "long_name": "samples"}),
+        },
         coords=coords,
     )
 
@@ -554,8 +639,9 @@ def ecdf(values) -> tuple[np.ndarray, np.ndarray]:
 
 
 def pairwise_tilt_rms(estimates: Mapping[str, Any], mask=None) -> xr.DataArray:
-    """RMS tilt difference (degrees) between every pair of estimates of the same recording
-    (agreement between filters when there is no ground truth).
+    """Compute the RMS tilt difference (degrees) between every pair of estimates.
+
+    The estimates are of the same recording (agreement between filters when there is no ground truth).
 
     Parameters
     ----------
@@ -591,5 +677,5 @@ def pairwise_tilt_rms(estimates: Mapping[str, Any], mask=None) -> xr.DataArray:
         dims=("estimator", "other"),
         coords={"estimator": names, "other": names},
         name="tilt_rms_difference",
-        attrs={"units": "deg"},
+        attrs={"units": "deg", "long_name": "RMS tilt difference"},
     )

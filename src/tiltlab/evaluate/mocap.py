@@ -17,7 +17,7 @@ def mocap_reference(
     drop_fraction: float = 0.02,
     cutoff_hz: float = 2.0,
 ) -> xr.Dataset:
-    r"""Reference head tilt from motion-capture markers, in the IMU frame (Fayat §2.6).
+    r"""Compute the reference head tilt from motion-capture markers, in the IMU frame (Fayat §2.6).
 
     The pipeline: (1) TTL synchronisation: the IMU samples flagged ``sync`` carry the
     video TTLs emitted every ``ttl_every`` frames; clock slips are repaired
@@ -44,6 +44,14 @@ def mocap_reference(
         Immobility threshold (°/s), see :func:`tiltlab.behavior.immobility`.
     gyr_offset : array_like (3,), optional
         Gyroscope offset (units of ``rec.gyr``) for the immobility detection.
+    drop_fraction : float
+        Fraction of the valid mocap frames dropped by the marker-distance quality
+        control, in [0, 1) (default 0.02, 2 %), see
+        :func:`tiltlab.calibration.marker_distance_qc`.
+    cutoff_hz : float
+        Low-pass cut-off (Hz) of the acceleration used for the IMU→head alignment
+        (default 2 Hz, as in Fayat et al.), see
+        :func:`tiltlab.calibration.imu_to_head_alignment`.
 
     Returns
     -------

@@ -1,4 +1,6 @@
-r"""Small recipes built on the selection and error functions: the parameters of a grid's
+r"""Small recipes built on the selection and error functions.
+
+The parameters of a grid's
 optimum, a method as a Recording → quaternions callable, the tilt difference between two
 methods on one Recording, and per-sample errors pooled over several Recordings.
 """
@@ -11,6 +13,7 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
+from .. import _deprecate
 from .. import filters as F
 from .errors import pairwise_tilt_rms, tilt_errors
 from .selection import optimum
@@ -21,20 +24,18 @@ __all__ = ["best_params", "estimator", "tilt_difference_rms", "pooled_errors"]
 _ESTIMATE_OPTIONS = ("use_mag", "gaps", "min_segment_s")
 
 
-def best_params(
-    scores: xr.DataArray, *, dim: str = "recording", params: Sequence[str] | None = None
-) -> dict[str, Any]:
-    """Parameters of the all-recordings optimum of a grid, without its score.
+def best_params(scores: xr.DataArray, **where) -> dict[str, Any]:
+    """Return the parameters of the all-recordings optimum of a grid, without its score.
 
     Parameters
     ----------
     scores : xarray.DataArray
-        Scores over parameter dims and ``dim`` (e.g. a :func:`grid_search` result with
-        its other dims selected away).
-    dim : str
-        The recording dimension, averaged over.
-    params : sequence of str, optional
-        Dims to optimise over (default: all but ``dim``).
+        Scores over parameter dims and the recording dim (e.g. a :func:`grid_search`
+        result with its other dims selected away).
+    **where
+        ``dim`` (the recording dimension, averaged over; default ``"recording"``) and
+        ``params`` (dims to optimise over; default all but ``dim``), as for
+        :func:`optimum`.
 
     Returns
     -------
@@ -57,12 +58,12 @@ def best_params(
     >>> best_params(scores)
     {'beta': 0.1}
     """
-    best = optimum(scores, dim=dim, params=params)
+    best = optimum(scores, **where)
     return {k: v for k, v in best.items() if k != "score"}
 
 
 def estimator(method: str, /, **params) -> Callable[[xr.Dataset], xr.DataArray]:
-    """A method with fixed parameters as a Recording → quaternions callable.
+    """Wrap a method with fixed parameters as a Recording → quaternions callable.
 
     The estimators of :func:`error_table` are such callables.
 
@@ -124,20 +125,22 @@ def _mask(recording: xr.Dataset, mask) -> np.ndarray | None:
     return np.asarray(mask, bool)
 
 
+@_deprecate.renamed(recording="rec")
 def tilt_difference_rms(
-    recording: xr.Dataset,
+    rec: xr.Dataset,
     method_a: str,
     method_b: str,
     *,
     mask: str | np.ndarray | None = "movement",
 ) -> float:
-    r"""RMS tilt difference (degrees) between two methods, with their default
-    parameters, on one Recording.
+    r"""Compute the RMS tilt difference (degrees) between two methods on one Recording.
+
+    Both run with their default parameters.
 
     Parameters
     ----------
-    recording : xarray.Dataset
-        A Recording both methods run on.
+    rec : xarray.Dataset
+        A Recording both methods run on; not modified.
     method_a, method_b : str
         Names of :data:`tiltlab.filters.METHODS` (two different ones).
     mask : str, array_like of bool or None
@@ -164,8 +167,8 @@ def tilt_difference_rms(
     """
     if method_a == method_b:
         raise ValueError(f"compare two different methods, got {method_a!r} twice")
-    m = _mask(recording, mask)
-    q = {name: F.estimate(recording, name) for name in (method_a, method_b)}
+    m = _mask(rec, mask)
+    q = {name: F.estimate(rec, name) for name in (method_a, method_b)}
     rms = pairwise_tilt_rms(q, mask=m)
     return float(rms.sel(estimator=method_a, other=method_b))
 
@@ -177,8 +180,9 @@ def pooled_errors(
     *,
     reference: str = "tilt_ref",
 ) -> np.ndarray:
-    """Per-sample tilt errors (degrees) of one method, over several Recordings
-    concatenated in order.
+    """Compute the per-sample tilt errors (degrees) of one method over Recordings.
+
+    The Recordings are concatenated in order.
 
     Parameters
     ----------

@@ -1,5 +1,6 @@
-r"""Scoring methods over parameter grids and recordings, and leave-one-trial-out (LOTO)
-parameter selection.
+r"""Scoring methods over parameter grids and recordings; LOTO parameter selection.
+
+LOTO: leave-one-trial-out.
 """
 
 from __future__ import annotations
@@ -17,9 +18,19 @@ import xarray as xr
 from .. import _validate as _v
 from .. import filters as F
 from ..filters.recordings import attr_value
+from .._labels import label_columns
 from .errors import tilt_rmse
 
 __all__ = ["grid_search", "optimum", "loto", "error_table", "loto_summary"]
+
+
+def _score_attrs(score_fn, first) -> dict:
+    """Units and long name of scores: those of a DataArray score, else tilt_rmse's."""
+    if isinstance(first, xr.DataArray) and "units" in first.attrs:
+        return {k: first.attrs[k] for k in ("units", "long_name") if k in first.attrs}
+    if score_fn is tilt_rmse:
+        return {"units": "deg", "long_name": "tilt RMSE"}
+    return {"units": "", "long_name": "score"}
 
 
 def _n_jobs(n_jobs) -> int:
@@ -57,6 +68,9 @@ def grid_search(
         ``score_fn(q, rec) -> float``, or an ``xarray.DataArray`` with the same dims
         and coords for every call (e.g. one score per behavioural ``state``), whose dims
         are appended after ``recording``; default :func:`tilt_rmse`.
+    use_mag : bool
+        Run the method with the magnetometer (9D; the Recordings need ``mag``); a
+        ``ValueError`` for a method that does not support one.
     n_jobs : int, optional
         Worker threads, default ``os.cpu_count()``.
     fixed : mapping, optional
@@ -67,7 +81,8 @@ def grid_search(
     -------
     xarray.DataArray
         Dims (one per grid parameter…, ``recording``, then the score's own dims),
-        attrs ``method``, ``use_mag`` and the fixed parameters.
+        attrs ``units`` and ``long_name`` (a DataArray score's, else ``"deg"`` for
+        :func:`tilt_rmse`), ``method``, ``use_mag`` and the fixed parameters.
     """
     m = F.get_method(method)
     if use_mag and not m.supports_mag:
@@ -100,7 +115,7 @@ def grid_search(
             **fixed,
             **{n: values[j][i] for j, (n, i) in enumerate(zip(names, ci))},
         }
-        q = F.run(method, data[ri], **params)
+        q = F.run_method(method, data[ri], **params)
         s = score_fn(q, recs[ri])
         return ci, ri, (s if isinstance(s, xr.DataArray) else float(s))
 
@@ -144,6 +159,7 @@ def grid_search(
         coords=coords,
         name="score",
         attrs={
+            **_score_attrs(score_fn, first),
             "method": method,
             "use_mag": int(bool(use_mag)),
             **{f"param_{k}": attr_value(v) for k, v in fixed.items()},
@@ -172,6 +188,9 @@ def optimum(
     ----------
     scores : xarray.DataArray
         Scores over parameter dims and ``dim`` (NaN-aware mean).
+    dim : str
+        The recording (trial) dimension the scores are averaged over (default
+        ``"recording"``).
     params : sequence of str, optional
         Dims to optimise over (default: all but ``dim``); other dims must be absent.
 
@@ -195,11 +214,18 @@ def optimum(
     return best
 
 
+def _param_attrs(scores: xr.DataArray, d: str) -> dict:
+    """Units and long name of the parameter ``d`` chosen without each trial."""
+    units = scores.coords[d].attrs.get("units", "") if d in scores.coords else ""
+    return {"units": str(units), "long_name": f"{d} chosen without the trial"}
+
+
 def loto(
     scores: xr.DataArray, *, dim: str = "recording", params: Sequence[str] | None = None
 ) -> xr.Dataset:
-    """Leave-one-trial-out selection: each trial scored with the parameters that minimise
-    the mean score over the *other* trials.
+    """Select parameters leaving one trial out (LOTO).
+
+    Each trial is scored with the parameters that minimise the mean score over the *other* trials.
 
     Parameters
     ----------
@@ -214,8 +240,9 @@ def loto(
     Returns
     -------
     xarray.Dataset
-        Over ``dim``: ``score`` (held-out score), and one variable per parameter with
-        the value chosen without that trial; attrs ``mean`` (mean held-out score),
+        Over ``dim``: ``score`` (held-out score, in the units of ``scores``), and one
+        variable per parameter with the value chosen without that trial (each with
+        ``units`` and ``long_name``); attrs ``mean`` (mean held-out score),
         ``optimistic_mean`` (all-trials optimum) and ``optimistic_<param>``.
     """
     p = _param_dims(scores, dim, params)
@@ -243,10 +270,17 @@ def loto(
             chosen[d].append(scores.coords[d].values[i])
     best = optimum(scores, dim=dim, params=p)
     coords = {dim: scores.coords[dim].values} if dim in scores.coords else {}
+    held_attrs = {
+        "units": str(scores.attrs.get("units", "")),
+        "long_name": f"held-out {scores.attrs.get('long_name', 'score')}",
+    }
     ds = xr.Dataset(
         {
-            "score": ((dim,), held),
-            **{d: ((dim,), np.asarray(v)) for d, v in chosen.items()},
+            "score": ((dim,), held, held_attrs),
+            **{
+                d: ((dim,), np.asarray(v), _param_attrs(scores, d))
+                for d, v in chosen.items()
+            },
         },
         coords=coords,
     )
@@ -309,20 +343,50 @@ def error_table(
         dims=("estimator", "recording"),
         coords={"estimator": names, "recording": labels},
         name="score",
+        attrs=_score_attrs(score_fn, None),
     )
+
+
+#: Long names of the columns of :func:`loto_summary`.
+_SUMMARY = {
+    "loto_mean": "mean held-out score (LOTO)",
+    "optimistic_mean": "mean score at the all-trials optimum",
+    "parameters": "parameters of the all-trials optimum",
+    "same_choice_all_folds": "same choice in every fold",
+    "n_trials": "trials",
+}
 
 
 def loto_summary(
     grids: Mapping[str, xr.DataArray], *, dim: str = "recording"
 ) -> pd.DataFrame:
-    """One row per method: LOTO mean score, optimistic all-trials optimum and the
-    parameters chosen (the optimum's; the folds' choices are in :func:`loto`).
+    """Summarise leave-one-trial-out selection, one row per method.
 
     Parameters
     ----------
     grids : mapping
         Method name → score DataArray over parameter dims and ``dim`` (other dims
         selected away).
+    dim : str
+        The trial dimension.
+
+    Returns
+    -------
+    pandas.DataFrame
+        Index the methods; columns ``loto_mean`` (mean held-out score),
+        ``optimistic_mean`` (the all-trials optimum, optimistic), ``parameters``
+        (the optimum's; the folds' choices are in :func:`loto`),
+        ``same_choice_all_folds`` and ``n_trials``; labelled (scores in the units of
+        the first grid).
+
+    Examples
+    --------
+    >>> import xarray as xr
+    >>> g = xr.DataArray([[3.0, 2.0, 2.5], [1.0, 1.5, 1.2]], dims=("beta", "recording"),
+    ...                  coords={"beta": [0.01, 0.1]}, attrs={"units": "deg"})
+    >>> t = loto_summary({"madgwick": g})
+    >>> t.loc["madgwick", "parameters"], t.attrs["units"]["loto_mean"]
+    ('beta=0.1', 'deg')
     """
     rows = {}
     for name, g in grids.items():
@@ -344,4 +408,10 @@ def loto_summary(
             "same_choice_all_folds": bool(stable),
             "n_trials": int(g.sizes[dim]),
         }
-    return pd.DataFrame.from_dict(rows, orient="index")
+    units = next(iter(grids.values())).attrs.get("units", "") if grids else ""
+    return label_columns(
+        pd.DataFrame.from_dict(rows, orient="index", columns=list(_SUMMARY)),
+        units={"loto_mean": units, "optimistic_mean": units, "n_trials": "1"}
+        | dict.fromkeys(["parameters", "same_choice_all_folds"], ""),
+        long_name=_SUMMARY,
+    )

@@ -16,7 +16,9 @@ Submodules
 * :mod:`~tiltlab.plot.scores` — estimator errors: parameter-grid heat maps and curves,
   per-trial bars, ECDFs, errors binned by speed;
 * :mod:`~tiltlab.plot.cohort` — Tukey boxplots and group means for cohort tables;
-* :mod:`~tiltlab.plot.learning` — training curves and per-trial errors by method.
+* :mod:`~tiltlab.plot.learning` — training curves and per-trial errors by method;
+* :mod:`~tiltlab.plot.tables` — :func:`table`, the table recipe: headers with units,
+  rounding by quantity, p-values written once.
 
 Everything is re-exported here: ``from tiltlab import plot; plot.kde_map(k)``.
 """
@@ -62,51 +64,25 @@ from .recording import (
     speed_trace,
 )
 from .scores import binned_errors, ecdf_plot, score_curves, score_heatmap, trial_bars
+from .tables import DECIMALS, MISSING, P_DECIMALS, table
+
+from .cohort import __all__ as _cohort_all
+from .filters import __all__ as _filters_all
+from .learning import __all__ as _learning_all
+from .mapfigures import __all__ as _mapfigures_all
+from .maps import __all__ as _maps_all
+from .recording import __all__ as _recording_all
+from .scores import __all__ as _scores_all
+from .tables import __all__ as _tables_all
 
 __all__ = [
-    # recording
-    "plot_recording",
-    "plot_vectors",
-    "shade_mask",
-    "series_panels",
-    "speed_trace",
-    "speed_histogram",
-    # maps
+    *_recording_all,
     "SENSOR_AXES",
-    "unit_globe",
-    "laea",
-    "tilt_projection",
-    "lonlat_deg",
-    "project",
-    "map_axes",
-    "plot_facets",
-    "plot_grid",
-    "plot_isopleths",
-    "plot_mask",
-    "plot_points",
-    "decorate",
-    "axis_names",
-    "axis_texts",
-    "sphere_3d",
-    "map_grid",
-    "facet_map",
-    "tilt_heatmap",
-    "tilt_overview",
-    "visited_map",
-    "kde_map",
-    "tilt_points_map",
-    "tilt_trace",
-    "residence_figure",
-    # scores
-    "score_heatmap",
-    "score_curves",
-    "trial_bars",
-    "ecdf_plot",
-    "binned_errors",
-    # cohort
-    "tukey_boxplot",
-    "group_lines",
-    # learning
-    "learning_curves",
-    "method_strips",
+    *_maps_all,
+    *_mapfigures_all,
+    *_scores_all,
+    *_cohort_all,
+    *_learning_all,
+    *_filters_all,
+    *_tables_all,
 ]

@@ -14,7 +14,7 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
-from ._common import label, legend_if_many, new_axes
+from ._common import Look, finish_axes, label, new_axes
 
 __all__ = ["tukey_boxplot", "group_lines"]
 
@@ -50,13 +50,11 @@ def tukey_boxplot(
     by: str,
     hue: str | None = None,
     ax=None,
-    units: str | None = None,
-    name: str | None = None,
     order: Sequence | None = None,
     hue_order: Sequence | None = None,
     points: bool = True,
     seed: int = 0,
-    title: str | None = None,
+    **look,
 ):
     """Tukey boxplots of a feature by category (and sub-category), with the sessions as dots.
 
@@ -74,24 +72,24 @@ def tukey_boxplot(
     hue : str, optional
         Column with side-by-side boxes within each category (e.g. ``"group"``), with a legend.
     ax : matplotlib.axes.Axes, optional
-    units : str, optional
-        Units of ``value`` (default the Dataset variable's ``attrs['units']``).
-    name : str, optional
-        y label (default ``value``).
+        Axes to draw on (default a new figure).
     order, hue_order : sequence, optional
         Category orders (default: categorical order, else order of appearance).
     points : bool
         Overlay the individual values, jittered.
     seed : int
         Seed of the jitter.
-    title : str, optional
+    **look
+        ``units`` of ``value`` (default the Dataset variable's ``attrs['units']``),
+        ``name`` (y label, default ``value``) and ``title``.
 
     Returns
     -------
     matplotlib.axes.Axes
     """
+    style, _ = Look.take(look, ("units", "name", "title"), "tukey_boxplot")
     df, u = _table(data, value)
-    units = units if units is not None else u
+    units = style.units if style.units is not None else u
     cats = _order(df, by, order)
     hues = _order(df, hue, hue_order) if hue is not None else [None]
     # at most the book's column width (8.4 in); few boxes get narrower
@@ -132,13 +130,13 @@ def tukey_boxplot(
             label=str(h) if h is not None else value,
         )
     ax.set_xticks(np.arange(len(cats)), [str(c) for c in cats])
-    ax.set_xlabel(by)
-    ax.set_ylabel(label(name or value, units))
-    if hue is not None:
-        legend_if_many(ax, title=hue)
-    if title:
-        ax.set_title(title)
-    return ax
+    return finish_axes(
+        ax,
+        by,
+        label(style.name or value, units),
+        legend_title=hue if hue is not None else False,
+        title=style.title,
+    )
 
 
 def group_lines(
@@ -148,12 +146,10 @@ def group_lines(
     x: str,
     hue: str,
     ax=None,
-    units: str | None = None,
-    name: str | None = None,
     err: str | None = "sem",
     order: Sequence | None = None,
     hue_order: Sequence | None = None,
-    title: str | None = None,
+    **look,
 ):
     """Centre of a feature per category of ``x`` (e.g. time points), one line per ``hue``.
 
@@ -168,15 +164,16 @@ def group_lines(
     hue : str
         Column with one line per value (e.g. ``"group"``), with a legend.
     ax : matplotlib.axes.Axes, optional
-    units : str, optional
-    name : str, optional
-        y label (default ``value``).
+        Axes to draw on (default a new figure).
     err : {"sem", "sd", "iqr", None}
         Error bars: standard error of the mean or standard deviation around the mean;
         ``"iqr"``: the median with its interquartile range (robust, as in Fayat et al.'s
         trajectories); None: the mean without bars.
     order, hue_order : sequence, optional
-    title : str, optional
+        Orders of the categories and of the lines.
+    **look
+        ``units`` of ``value`` (default the Dataset variable's), ``name`` (y label,
+        default ``value``) and ``title``.
 
     Returns
     -------
@@ -184,8 +181,9 @@ def group_lines(
     """
     if err not in ("sem", "sd", "iqr", None):
         raise ValueError(f"err must be 'sem', 'sd', 'iqr' or None, got {err!r}")
+    style, _ = Look.take(look, ("units", "name", "title"), "group_lines")
     df, u = _table(data, value)
-    units = units if units is not None else u
+    units = style.units if style.units is not None else u
     xs = _order(df, x, order)
     ax = new_axes(ax, figsize=(4.5, 3.2))
     for h in _order(df, hue, hue_order):
@@ -218,9 +216,6 @@ def group_lines(
                 label=str(h),
             )
     ax.set_xticks(range(len(xs)), [str(v) for v in xs], rotation=45)
-    ax.set_xlabel(x)
-    ax.set_ylabel(label(name or value, units))
-    legend_if_many(ax, title=hue, fontsize=8)
-    if title:
-        ax.set_title(title)
-    return ax
+    return finish_axes(
+        ax, x, label(style.name or value, units), legend_title=hue, title=style.title
+    )

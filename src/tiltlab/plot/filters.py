@@ -1,5 +1,6 @@
-"""Figures of several tilt estimates of one recording: the estimates' tilt angles against
-time and their errors against a reference, with one legend for the whole figure.
+"""Figures of several tilt estimates of one recording.
+
+The estimates' tilt angles against time and their errors against a reference, with one legend for the whole figure.
 
 Inputs are the quaternions that :func:`tiltlab.filters.estimate` returns, by method; the
 recipe computes only what it draws (tilt angles and a running RMS of the errors).
@@ -55,6 +56,8 @@ def running_rms(values, window: int) -> np.ndarray:
     Parameters
     ----------
     values : array_like, shape (N,)
+        The series (flattened; e.g. per-sample errors in degrees), NaN for missing
+        samples.
     window : int
         Window length in samples (≥ 1).
 
@@ -75,14 +78,16 @@ def running_rms(values, window: int) -> np.ndarray:
 
 
 def plain_log_ticks(ax, axis: str = "y"):
-    """Label a log-scaled axis with plain numbers (0.5, 1, 2, 5 …) instead of powers of
-    ten, and no minor labels, so that short decades do not crowd their labels.
+    """Label a log-scaled axis with plain numbers (0.5, 1, 2, 5 …).
+
+    Plain numbers instead of powers of ten, and no minor labels, so that short decades do not crowd their labels.
 
     Parameters
     ----------
     ax : matplotlib.axes.Axes
         Axes whose ``axis`` is already log-scaled and drawn (limits set).
     axis : {"x", "y"}
+        Which axis to label (default ``"y"``).
 
     Returns
     -------
@@ -112,7 +117,9 @@ def estimates_overview(
     title: str | None = None,
     figsize: tuple[float, float] | None = None,
 ):
-    """Several estimates of one recording together: tilt angle against time (top) and,
+    """Show several estimates of one recording together.
+
+    Tilt angle against time (top) and,
     when errors are given, a running RMS of each estimate's tilt error (bottom, log
     scale), with one legend for the figure (below the panels).
 
@@ -135,6 +142,7 @@ def estimates_overview(
         At most this many points per line are drawn (every k-th sample), so that long
         recordings stay light.
     title : str, optional
+        Figure title, above the panels.
     figsize : (float, float), optional
         Default 8.2 inches wide (the book's column holds 8.36 inches at 100 dpi).
 

@@ -82,7 +82,9 @@ def method_strips(
     hue : mapping, optional
         Trial → group label (e.g. "undisturbed" / "disturbed"), coloured separately.
     logy : bool
+        Logarithmic error axis, ticks labelled with plain numbers (1, 3, 10 …).
     ax : matplotlib.axes.Axes, optional
+        Axes to draw on; default a new figure of size ``figsize``.
     figsize : (float, float)
         Size of a new figure in inches (default: the book's column width).
 

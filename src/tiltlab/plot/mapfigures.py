@@ -1,4 +1,6 @@
-"""Sphere figure recipes: heat maps of time on the sphere, visited facets, KDE maps with
+"""Sphere figure recipes.
+
+Heat maps of time on the sphere, visited facets, KDE maps with
 isopleths, grids of maps and residence maps, built on the LAEA primitives of
 :mod:`tiltlab.plot.maps`. Each takes its data first (labelled where possible), an optional
 ``ax``, and adds colour bars and units.
@@ -14,7 +16,7 @@ import xarray as xr
 
 from .. import axes as _axes
 from .. import sphere as S
-from ._common import label, legend_if_many, units_of
+from ._common import Look, label, legend_below, legend_if_many, units_of
 from .maps import (
     tilt_projection,
     project,
@@ -77,7 +79,7 @@ def _mesh_of(tmap: xr.Dataset, mesh):
 
 
 def _as_map(data, mesh):
-    """A tilt map from a tilt-map Dataset or from tilt vectors (labelled or plain)."""
+    """Return a tilt map from a tilt-map Dataset or from tilt vectors (labelled or plain)."""
     if _is_map(data):
         return data, _mesh_of(data, mesh)
     mesh = S.sphere_mesh() if mesh is None else mesh
@@ -93,7 +95,7 @@ def map_grid(
     figsize: tuple[float, float] | None = None,
     **kw,
 ):
-    """A figure with ``n`` LAEA map axes in a grid.
+    """Make a figure with ``n`` LAEA map axes in a grid.
 
     Parameters
     ----------
@@ -108,6 +110,7 @@ def map_grid(
         for a legend below the map. Default: the grid fits the book's column,
         ``min(4.2, MAX_WIDTH_IN / ncols)``.
     figsize : (float, float), optional
+        Figure size (inches); overrides ``panel_size``.
     **kw
         Passed to :func:`laea` (``nose_up``).
 
@@ -137,19 +140,26 @@ def map_grid(
     return fig, axes
 
 
+_FACET_LOOK = ("name", "units", "cmap", "colorbar", "axis_labels", "title")
+_KDE_LOOK = (
+    "cmap",
+    "iso_color",
+    "colorbar",
+    "labels",
+    "axis_labels",
+    "grid_step_deg",
+    "point_kw",
+    "title",
+)
+
+
 def facet_map(
     values,
     mesh: S.SphereMesh | None = None,
     *,
     ax=None,
-    name: str | None = None,
-    units: str | None = None,
     log: bool = False,
-    cmap="viridis",
-    colorbar: bool = True,
     decorate_kw: dict | None = None,
-    axis_labels=None,
-    title: str | None = None,
     **kw,
 ):
     """Colour the facets of a triangulated sphere on a LAEA map, with gridlines and a colour bar.
@@ -163,45 +173,44 @@ def facet_map(
         Default the 5000-vertex Fibonacci mesh.
     ax : GeoAxes, optional
         A map axes (:func:`map_axes`, :func:`map_grid`); default a new figure centred on +z.
-    name, units : str, optional
-        Colour-bar label and units (default from the DataArray, else ``"value"``).
     log : bool
         Colour by log10 of the values (non-positive values are left blank).
-    cmap : str or Colormap
-    colorbar : bool
     decorate_kw : dict, optional
         Passed to :func:`decorate`.
-    axis_labels : data or sequence of 3 str, optional
-        What the sensor axes point to (:func:`axis_names`); default read from
-        ``values``' attrs, else plain ``+x``, ``+y``, ``+z``.
-    title : str, optional
     **kw
-        Passed to :func:`plot_facets`.
+        The look: ``name`` and ``units`` (colour-bar label and units; default from
+        the DataArray, else ``"value"``), ``cmap`` (default ``"viridis"``),
+        ``colorbar`` (default True), ``axis_labels`` (what the sensor axes point to,
+        :func:`axis_names`; default read from ``values``' attrs, else plain ``+x``,
+        ``+y``, ``+z``) and ``title``; any other keyword is passed to
+        :func:`plot_facets`.
 
     Returns
     -------
     GeoAxes
     """
+    look, kw = Look.take(kw, _FACET_LOOK, "facet_map", rest=True)
     ax = _map_ax(ax)
+    axis_labels = look.axis_labels
     if axis_labels is None and isinstance(values, xr.DataArray):
         axis_labels = values
     name = (
-        name
+        look.name
         or (values.attrs.get("long_name") if isinstance(values, xr.DataArray) else None)
         or "value"
     )
-    units = units if units is not None else units_of(values)
+    units = look.units if look.units is not None else units_of(values)
     v = np.asarray(values, float)
     if log:
         with np.errstate(divide="ignore", invalid="ignore"):
             v = np.where(v > 0, np.log10(v), np.nan)
         name = f"log10 {name}"
-    art = plot_facets(ax, v, mesh, cmap=cmap, **kw)
+    art = plot_facets(ax, v, mesh, cmap=look.cmap, **kw)
     decorate(ax, **({"axis_labels": axis_labels} | (decorate_kw or {})))
-    if colorbar:
+    if look.colorbar:
         _colorbar(ax, art, label(name, units))
-    if title:
-        ax.set_title(title, fontsize=9)
+    if look.title:
+        ax.set_title(look.title, fontsize=9)
     return ax
 
 
@@ -231,8 +240,12 @@ def tilt_heatmap(
     log : bool
         Colour by log10 (facets never visited stay blank either way).
     ax : GeoAxes, optional
+        A map axes (:func:`map_axes`, :func:`map_grid`); default a new 5 × 5 in figure
+        centred on +z.
     cmap : str or Colormap
+        Colour map of the facets (default ``"magma"``).
     title : str, optional
+        Title above the map.
     **kw
         Passed to :func:`facet_map`.
 
@@ -274,13 +287,14 @@ def tilt_overview(
     traj_kw: dict | None = None,
     figsize=(MAX_WIDTH_IN, 3.8),
 ):
-    """A 3-D sphere with the trajectory beside the LAEA heat map of the same tilt map.
+    """Show a 3-D sphere with the trajectory beside the LAEA heat map of the same tilt map.
 
     Parameters
     ----------
     tilt : xarray.DataArray, xarray.Dataset or array_like
         Tilt vectors (labelled (time, axis) with ``fs``, a Recording with ``gravity``, or (N, 3)).
     mesh : SphereMesh, optional
+        The map's mesh (default the 5000-vertex Fibonacci mesh).
     quantity, log, cmap
         As in :func:`tilt_heatmap`.
     traj_kw : dict, optional
@@ -351,16 +365,25 @@ def visited_map(
         E.g. ``{"active": g[~immobile], "immobile": g[immobile]}``; later entries are drawn
         on top.
     mesh : SphereMesh, optional
+        The mesh of the maps (default a tilt map's own mesh, else the 5000-vertex
+        Fibonacci mesh).
     colors : sequence of colours, optional
         One per series (default green, red, blue...).
     alpha : float
+        Opacity of the visited facets and of their legend patches, in [0, 1].
     ax : GeoAxes, optional
+        A map axes (:func:`map_axes`, :func:`map_grid`); default a new 5 × 5 in figure
+        centred on +z.
     min_count : int
+        Minimum number of samples (≥ 1) for a facet to count as visited.
     legend : bool
+        Add a legend below the map, each series with its visited percentage of the
+        sphere (by area).
     decorate_kw : dict, optional
         Passed to :func:`decorate`; the sensor axes are named from the first series
         whose attrs have ``axis_labels``.
     title : str, optional
+        Title above the map.
 
     Returns
     -------
@@ -389,13 +412,7 @@ def visited_map(
         )
     decorate(ax, **({"fontsize": 8, "axis_labels": names} | (decorate_kw or {})))
     if legend:
-        ax.legend(
-            handles=handles,
-            loc="upper center",
-            bbox_to_anchor=(0.5, -0.02),
-            fontsize=8,
-            frameon=False,
-        )
+        legend_below(ax, handles)
     if title:
         ax.set_title(title, fontsize=9)
     return ax
@@ -411,16 +428,9 @@ def kde_map(
     centre=(0.0, 0.0, 1.0),
     extent: float | None = None,
     ax=None,
-    cmap="viridis",
-    iso_color="w",
-    colorbar: bool = True,
-    labels: dict | None = None,
-    axis_labels=None,
-    grid_step_deg: float | None = None,
-    point_kw: dict | None = None,
-    title: str | None = None,
+    **look,
 ):
-    """A spherical KDE on a LAEA map with its cumulative isopleths (Benhamou Fig. 5).
+    """Map a spherical KDE on a LAEA map with its cumulative isopleths (Benhamou Fig. 5).
 
     Parameters
     ----------
@@ -440,18 +450,16 @@ def kde_map(
     extent : float, optional
         Half-width of the view in map units (2 = the whole sphere); default global.
     ax : GeoAxes, optional
-    cmap, iso_color
-        Colour map of the density and colour of the isopleth lines.
-    colorbar : bool
-    labels : dict, optional
-        Sensor-axis labels for :func:`decorate` (``{}`` for none).
-    axis_labels : data or sequence of 3 str, optional
-        What the sensor axes point to (:func:`axis_names`) when ``labels`` is not
-        given; default read from labelled ``points``, else plain ``+x``, ``+y``.
-    grid_step_deg : float, optional
-        Gridline spacing (default 30°, 10° for a zoomed view).
-    point_kw : dict, optional
-    title : str, optional
+        Map axes to draw on (default a new figure centred on ``centre``).
+    **look
+        ``cmap`` and ``iso_color`` (colour map of the density, default
+        ``"viridis"``, and colour of the isopleth lines, default white),
+        ``colorbar`` (default True), ``labels`` (sensor-axis labels for
+        :func:`decorate`, ``{}`` for none), ``axis_labels`` (what the sensor axes
+        point to, :func:`axis_names`, when ``labels`` is not given; default read from
+        labelled ``points``, else plain ``+x``, ``+y``), ``grid_step_deg`` (gridline
+        spacing, default 30°, 10° for a zoomed view), ``point_kw`` (style of the
+        points) and ``title``.
 
     Returns
     -------
@@ -459,6 +467,8 @@ def kde_map(
     """
     from matplotlib.lines import Line2D
 
+    style, _ = Look.take(look, _KDE_LOOK, "kde_map")
+    iso_color, point_kw = style.iso_color, style.point_kw
     if not isinstance(kde, S.SphericalKDE):
         raise TypeError(
             f"kde must be a tiltlab.sphere.SphericalKDE, got {type(kde).__name__}"
@@ -481,7 +491,7 @@ def kde_map(
         name = label("log10 density", "1/sr")
     else:
         raise ValueError(f"scale must be 'sqrt', 'linear' or 'log', got {scale!r}")
-    art = plot_grid(ax, shown, kde.grid, cmap=cmap)
+    art = plot_grid(ax, shown, kde.grid, cmap=style.cmap)
     levels = sorted(float(x) for x in np.atleast_1d(levels))
     styles = ["-", "--", ":", "-."]
     handles = []
@@ -521,25 +531,21 @@ def kde_map(
         e = float(extent)
         ax.set_extent([-e, e, -e, e], crs=ax.projection)
     step = (
-        grid_step_deg
-        if grid_step_deg is not None
+        style.grid_step_deg
+        if style.grid_step_deg is not None
         else (10.0 if extent is not None and extent < 1 else 30.0)
     )
+    axis_labels = style.axis_labels
     if axis_labels is None and points is not None and hasattr(points, "attrs"):
         axis_labels = points
-    decorate(ax, labels=labels, axis_labels=axis_labels, grid_step_deg=step, fontsize=8)
-    if colorbar:
-        _colorbar(ax, art, name)
-    ax.legend(
-        handles=handles,
-        loc="upper center",
-        bbox_to_anchor=(0.5, -0.02),
-        fontsize=8,
-        frameon=False,
-        ncol=len(handles),
+    decorate(
+        ax, labels=style.labels, axis_labels=axis_labels, grid_step_deg=step, fontsize=8
     )
-    if title:
-        ax.set_title(title, fontsize=9)
+    if style.colorbar:
+        _colorbar(ax, art, name)
+    legend_below(ax, handles, ncol=len(handles))
+    if style.title:
+        ax.set_title(style.title, fontsize=9)
     return ax
 
 
@@ -568,12 +574,17 @@ def tilt_points_map(
         sits at the pole (Fayat et al. Fig. 3e): distances to the pole are then distances
         to the baseline.
     ax : GeoAxes, optional
+        A map axes (:func:`map_axes`, :func:`map_grid`); default a new 5 × 5 in figure
+        centred on +z.
     extent : float
         Half-width of the view in map units.
     grid_step_deg : float
+        Spacing of the meridians and parallels (degrees), also printed in the map's
+        corner.
     axis_labels : data or sequence of 3 str, optional
         What the sensor axes point to (:func:`axis_names`); default plain ``+x``, ``+y``.
     title : str, optional
+        Title above the map.
     **kw
         Marker style.
 
@@ -633,7 +644,7 @@ def tilt_points_map(
 
 
 def tilt_trace(tilt, *, ax=None, axis_labels=None, title: str | None = None, **kw):
-    """A tilt trajectory on the plane of the tilt LAEA projection (no map axes needed).
+    """Draw a tilt trajectory on the plane of the tilt LAEA projection (no map axes needed).
 
     +x points up and +y left, as seen from above; the dashed circle of radius √2 is the
     horizon (tilt 90°). The axis titles name what +x and +y point to when the data say
@@ -644,9 +655,11 @@ def tilt_trace(tilt, *, ax=None, axis_labels=None, title: str | None = None, **k
     tilt : xarray.DataArray, xarray.Dataset or array_like
         Tilt vectors (a labelled (time, axis) series, a Recording with ``gravity``, or (N, 3)).
     ax : matplotlib.axes.Axes, optional
+        Plain axes to draw on; default a new 4.5 × 4.5 in figure.
     axis_labels : data or sequence of 3 str, optional
         What the sensor axes point to (:func:`axis_names`); default from ``tilt``.
     title : str, optional
+        Title above the plot.
     **kw
         Style of the trajectory line.
 
@@ -704,7 +717,7 @@ def residence_figure(
         "mean residence time per visit",
     ),
 ):
-    """Maps of visits and mean residence time per cap, and optionally RT(i), NV(i) along the trajectory.
+    """Map visits and mean residence time per cap, optionally RT(i), NV(i) along the track.
 
     Parameters
     ----------
@@ -716,10 +729,13 @@ def residence_figure(
         Times (s) and values from :func:`tiltlab.sphere.residence_series` (convert its
         sample index to seconds first).
     cmap : str or Colormap
+        Colour map of both maps (default ``"cividis"``).
     figsize : (float, float), optional
         Default: two maps side by side, 8.4 in (the book's column) wide; with ``series``
         the trajectory panel spans the column below them.
     panel_titles : (str, str)
+        Titles of the visits map and of the residence-time map; the text before
+        ``" per "`` names the colour-bar quantity.
 
     Returns
     -------

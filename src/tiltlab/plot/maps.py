@@ -1,4 +1,6 @@
-r"""Sphere figures: 3-D facet renderings, Lambert azimuthal equal-area (LAEA) maps and
+r"""Sphere figures.
+
+3-D facet renderings, Lambert azimuthal equal-area (LAEA) maps and
 the chapters' map recipes (time-on-sphere heat maps, visited facets, KDE maps with
 isopleths, grids of maps with colour bars).
 
@@ -136,7 +138,13 @@ def axis_texts(obj: Any = None) -> dict[str, str]:
 
 
 def unit_globe():
-    """A cartopy Globe that is the unit sphere."""
+    """Return a cartopy Globe that is the unit sphere.
+
+    Returns
+    -------
+    cartopy.crs.Globe
+        The unit sphere (semi-axes 1).
+    """
     import cartopy.crs as ccrs
 
     return ccrs.Globe(ellipse=None, semimajor_axis=1.0, semiminor_axis=1.0)
@@ -176,7 +184,13 @@ def laea(centre=(0.0, 0.0, 1.0), *, nose_up: bool | None = None):
 
 
 def tilt_projection():
-    """The projection of a tilt map: centred on +z, +x up, +y left (seen from above)."""
+    """Return the projection of a tilt map: centred on +z, +x up, +y left.
+
+    Returns
+    -------
+    cartopy.crs.LambertAzimuthalEqualArea
+        The LAEA projection of the unit sphere seen from above.
+    """
     return laea((0.0, 0.0, 1.0))
 
 

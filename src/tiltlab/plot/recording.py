@@ -16,6 +16,7 @@ import xarray as xr
 
 from .. import axes as _axes
 from ._common import (
+    Look,
     AXIS_COLOURS,
     label,
     legend_if_many,
@@ -74,10 +75,13 @@ def shade_mask(
     Parameters
     ----------
     ax : matplotlib.axes.Axes
+        Axes to shade (drawn behind the data, ``zorder`` 0).
     time : array_like, shape (N,)
         Sample times (s).
     mask : array_like of bool, shape (N,)
+        True on the samples to shade; each run of True samples becomes one span.
     color : str
+        Matplotlib colour of the spans (default ``"0.9"``, light grey).
     label : str, optional
         Legend entry of the first span.
     """
@@ -111,13 +115,18 @@ def plot_vectors(
     Parameters
     ----------
     ax : matplotlib.axes.Axes
+        Axes to draw on.
     time : array_like, shape (N,)
+        Abscissa of the samples (e.g. times in s).
     values : array_like, shape (N, k)
+        One line per column, for the first ``len(labels)`` columns.
     labels : sequence of str
         Component names (legend entries; ``x``, ``y``, ``z``, ``w`` get fixed colours,
         also when followed by a description, as in ``"x (forward)"``).
     ylabel : str
+        Y-axis label (default none).
     lw : float
+        Line width (points).
     """
     values = np.asarray(values)
     for k, lab in enumerate(labels):
@@ -157,7 +166,9 @@ def plot_recording(
     shade_label : str, optional
         Legend entry of the shaded spans (default: the variable name, or "shaded").
     title : str, optional
+        Title above the first panel.
     figsize : (float, float), optional
+        Figure size (inches); default the book's width, 2 in per panel plus 0.6 in.
 
     Returns
     -------
@@ -214,9 +225,8 @@ def series_panels(
     styles: Mapping[str, dict] | None = None,
     ylim: Mapping[str, tuple] | None = None,
     logy: bool | Sequence[str] = False,
-    title: str | None = None,
-    figsize: tuple[float, float] | None = None,
     sharex: bool = True,
+    **look,
 ):
     """Stacked panels of named series against a common time axis, one legend per panel.
 
@@ -240,9 +250,11 @@ def series_panels(
         Panel label → y limits.
     logy : bool or sequence of str
         Log scale for all panels, or for the named ones.
-    title : str, optional
-    figsize : (float, float), optional
     sharex : bool
+        Share the time axis between the panels.
+    **look
+        ``title`` (above the first panel) and ``figsize`` (inches; default the
+        book's width, 1.9 in per panel).
 
     Returns
     -------
@@ -250,13 +262,14 @@ def series_panels(
     """
     if not panels:
         raise ValueError("panels is empty")
+    style, _ = Look.take(look, ("title", "figsize"), "series_panels")
     styles = styles or {}
     fig, axes = plt.subplots(
         len(panels),
         1,
         sharex=sharex,
         squeeze=False,
-        figsize=figsize or (FIG_WIDTH, 1.9 * len(panels) + 0.8),
+        figsize=style.figsize or (FIG_WIDTH, 1.9 * len(panels) + 0.8),
     )
     for ax, (name, lines) in zip(axes[:, 0], panels.items()):
         if not isinstance(lines, Mapping):
@@ -283,8 +296,8 @@ def series_panels(
         legend_if_many(ax, loc="upper left", bbox_to_anchor=(1.005, 1.0), frameon=False)
         _thicken(ax.get_legend())
     axes[-1, 0].set_xlabel(label(xlabel, xunits))
-    if title:
-        axes[0, 0].set_title(title)
+    if style.title:
+        axes[0, 0].set_title(style.title)
     fig.tight_layout()
     return fig
 
@@ -320,6 +333,7 @@ def speed_trace(
     log : bool
         Logarithmic speed axis.
     ax : matplotlib.axes.Axes, optional
+        Axes to draw on; default a new figure (book width, 3 in high).
     window : (float, float), optional
         Time window (s) to show.
 
@@ -388,7 +402,10 @@ def speed_histogram(
     units : str, optional
         Default the first series' ``attrs['units']``, else ``"deg/s"``.
     density : bool
+        Normalise each histogram to unit area (probability density per log10 unit);
+        False plots sample counts.
     ax : matplotlib.axes.Axes, optional
+        Axes to draw on; default a new 6 × 3 in figure.
 
     Returns
     -------

@@ -1,4 +1,6 @@
-"""Figures of estimator errors: parameter-grid heat maps and curves, per-trial bars,
+"""Figures of estimator errors.
+
+Parameter-grid heat maps and curves, per-trial bars,
 error distributions and errors binned by angular speed.
 
 Inputs are the tables that :mod:`tiltlab.evaluate` and :func:`tiltlab.evaluate.grid_search`
@@ -15,13 +17,13 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
-from ._common import label, legend_if_many, new_axes, units_of
+from ._common import finish_axes, label, legend_if_many, new_axes, units_of
 
 __all__ = ["score_heatmap", "score_curves", "trial_bars", "ecdf_plot", "binned_errors"]
 
 
 def _fmt(v) -> str:
-    """A tick label as a plain number (``0.00001``, not ``1e-05``)."""
+    """Write a tick label as a plain number (``0.00001``, not ``1e-05``)."""
     try:
         x = float(v)
     except (TypeError, ValueError):
@@ -51,6 +53,7 @@ def score_heatmap(
         a :func:`tiltlab.evaluate.grid_search` result). The first is drawn on y, the
         second on x; coordinate values label the ticks.
     ax : matplotlib.axes.Axes, optional
+        Axes to draw on; default a new 4.5 × 3.5 in figure.
     log : bool
         Colour on a logarithmic scale; the colour bar is labelled with plain numbers in
         the score's units.
@@ -61,7 +64,9 @@ def score_heatmap(
     mark_best : bool
         Circle the minimum.
     cmap : str or Colormap
+        Colour map of the cells (default ``"viridis"``).
     title : str, optional
+        Axes title.
     param_units : mapping, optional
         Units of the parameters on the axes (a coordinate's ``attrs['units']`` wins);
         default :data:`tiltlab.filters.PARAMETER_UNITS`; a dimensionless one (``"1"``)
@@ -126,7 +131,7 @@ def score_curves(
     units: str | None = None,
     title: str | None = None,
 ):
-    """A score against one parameter, one line per value of another dimension.
+    """Plot a score against one parameter, one line per value of another dimension.
 
     Parameters
     ----------
@@ -138,12 +143,17 @@ def score_curves(
     hue : str, optional
         Dimension with one line per value (default: the other dimension, if any).
     ax : matplotlib.axes.Axes, optional
-    logx, logy : bool
+        Axes to draw on; default a new 5 × 3.3 in figure.
+    logx : bool
+        Logarithmic abscissa, with ticks labelled at the parameter values.
+    logy : bool
+        Logarithmic score axis.
     name : str
         What the score is (y label).
     units : str, optional
         Default ``attrs['units']``, else ``"deg"``.
     title : str, optional
+        Axes title.
 
     Returns
     -------
@@ -173,12 +183,24 @@ def score_curves(
         ax.minorticks_off()
     if logy:
         ax.set_yscale("log")
-    ax.set_xlabel(label(x, scores[x].attrs.get("units")))
-    ax.set_ylabel(label(name, units or units_of(scores, "deg")))
-    legend_if_many(ax, title=hue)
-    if title:
-        ax.set_title(title)
-    return ax
+    return finish_axes(
+        ax,
+        label(x, scores[x].attrs.get("units")),
+        label(name, units or units_of(scores, "deg")),
+        legend_title=hue,
+        title=title,
+    )
+
+
+def _common_units(df: pd.DataFrame) -> str | None:
+    """Return the units every column of a labelled table shares (None if they differ)."""
+    units = df.attrs.get("units")
+    if isinstance(units, str):
+        return units or None
+    if isinstance(units, dict):
+        found = {str(units.get(c, "")) for c in df.columns}
+        return found.pop() if len(found) == 1 and "" not in found else None
+    return None
 
 
 def trial_bars(
@@ -192,7 +214,7 @@ def trial_bars(
     title: str | None = None,
     figsize=(9, 5),
 ):
-    """Grouped bars: one group per trial, one bar per estimator (or any column).
+    """Draw grouped bars: one group per trial, one bar per estimator (or any column).
 
     Parameters
     ----------
@@ -200,14 +222,20 @@ def trial_bars(
         Rows = trials, columns = estimators (a 2-D DataArray is converted with
         ``to_pandas()``; its ``units`` label the axis).
     ax : matplotlib.axes.Axes, optional
+        Axes to draw on; default a new figure of size ``figsize``.
     logy : bool
+        Logarithmic value axis (the y label then says "log scale").
     name : str
         What the values are (y label).
     units : str, optional
-        Default ``attrs['units']`` (DataFrame: ``df.attrs['units']``), else ``"deg"``.
+        Default ``attrs['units']`` (DataFrame: the units all its columns share in
+        ``df.attrs['units']``), else ``"deg"``.
     legend_title : str
+        Title of the legend (beside the axes) naming the columns.
     title : str, optional
+        Axes title.
     figsize : (float, float)
+        Size (inches) of the new figure when ``ax`` is not given.
 
     Returns
     -------
@@ -216,7 +244,7 @@ def trial_bars(
     u = (
         units
         or units_of(table)
-        or (table.attrs.get("units") if isinstance(table, pd.DataFrame) else None)
+        or (_common_units(table) if isinstance(table, pd.DataFrame) else None)
         or "deg"
     )
     df = table.to_pandas() if isinstance(table, xr.DataArray) else pd.DataFrame(table)
@@ -257,7 +285,9 @@ def ecdf_plot(
     mask : array_like of bool, optional
         Samples to keep (e.g. immobility).
     ax : matplotlib.axes.Axes, optional
+        Axes to draw on; default a new 5 × 3.5 in figure.
     logx : bool
+        Logarithmic error axis.
     name : str
         What the errors are (x label).
     units : str, optional
@@ -265,11 +295,15 @@ def ecdf_plot(
     vline : float, optional
         A reference value (e.g. the optical reference's uncertainty), drawn dashed.
     vline_label : str, optional
+        Legend entry of the ``vline`` line (default its value to two significant
+        digits).
     title : str, optional
+        Axes title.
 
     Returns
     -------
     matplotlib.axes.Axes
+        The axes, with one empirical CDF per series and the legend.
     """
     ax = new_axes(ax, figsize=(5, 3.5))
     for k, (m, e) in enumerate(errors.items()):
@@ -309,16 +343,20 @@ def binned_errors(
         From :func:`tiltlab.evaluate.binned_by_speed`: ``median``, ``q25``, ``q75`` with
         dims (estimator, speed).
     ax : matplotlib.axes.Axes, optional
+        Axes to draw on; default a new 5 × 3.5 in figure.
     logy : bool
+        Logarithmic error axis.
     name, units : str
         y label and units.
     xname, xunits : str
         x label and units (the bin centres).
     title : str, optional
+        Axes title.
 
     Returns
     -------
     matplotlib.axes.Axes
+        The axes, with each estimator's median and interquartile band per bin.
     """
     ax = new_axes(ax, figsize=(5, 3.5))
     xdim = [d for d in bins["median"].dims if d != "estimator"][0]

@@ -1,5 +1,6 @@
-r"""Group statistics of cohort features (layer 7): rank tests between groups and against
-baseline, multiple-comparison adjustments (including Fayat et al.'s uncapped
+r"""Group statistics of cohort features (layer 7).
+
+Rank tests between groups and against baseline, multiple-comparison adjustments (including Fayat et al.'s uncapped
 Bonferroni convention), effect sizes with confidence intervals, a longitudinal mixed
 model, and power by simulation.
 
@@ -50,6 +51,8 @@ from .multiple import (
 )
 from .nonparametric import (
     ALTERNATIVES,
+    EXACT_MAX_CELLS,
+    EXACT_MAX_PAIRS,
     ZERO_METHODS,
     TestResult,
     exact_p_lattice,
@@ -91,54 +94,24 @@ from .tables import (
     long_table,
 )
 
+from .design import __all__ as _design_all
+from .effects import __all__ as _effects_all
+from .mixed import __all__ as _mixed_all
+from .multiple import __all__ as _multiple_all
+from .nonparametric import __all__ as _nonparametric_all
+from .power import __all__ as _power_all
+from .published import __all__ as _published_all
+from .summaries import __all__ as _summaries_all
+from .tables import __all__ as _tables_all
+
 __all__ = [
-    "StudyDesign",
-    "design_tables",
-    "session_table",
-    "study_design",
-    "FAYAT_DESIGN",
-    "FAYAT_FEATURE_TABLES",
-    "FAYAT_TABLES",
-    "FAYAT_TIME_POINTS",
-    "fayat_table",
-    "ALTERNATIVES",
-    "ZERO_METHODS",
-    "TestResult",
-    "mann_whitney",
-    "wilcoxon_signed_rank",
-    "mwu_null_distribution",
-    "signed_rank_null_distribution",
-    "exact_p_lattice",
-    "signed_rank_p_lattice",
-    "ADJUSTMENTS",
-    "FAYAT_FAMILIES",
-    "adjust",
-    "paper_bonferroni",
-    "add_adjustments",
-    "Interval",
-    "hodges_lehmann",
-    "prob_superiority",
-    "rank_biserial",
-    "paired_rank_biserial",
-    "paired_prob_superiority",
-    "MixedModelResult",
-    "mixed_model",
-    "PowerResult",
-    "normal_shift",
-    "observed_shift",
-    "normal_shift_superiority",
-    "noether_n_per_group",
-    "power_by_simulation",
-    "animals_needed",
-    "THRESHOLDS",
-    "COLOURS",
-    "long_table",
-    "between_groups",
-    "against_baseline",
-    "check_cells",
-    "format_table",
-    "group_quantiles",
-    "significant_cells",
-    "with_published",
-    "recovery_table",
+    *_design_all,
+    *_published_all,
+    *_nonparametric_all,
+    *_multiple_all,
+    *_effects_all,
+    *_mixed_all,
+    *_power_all,
+    *_tables_all,
+    *_summaries_all,
 ]

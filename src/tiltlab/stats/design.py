@@ -1,5 +1,6 @@
-"""The design of a study, read from its cohort table and stated choices: groups and their
-order, the control group, time points and the baseline, one-sided test directions and
+"""The design of a study, read from its cohort table and stated choices.
+
+Groups and their order, the control group, time points and the baseline, one-sided test directions and
 the families of comparisons (:func:`study_design`).
 
 A chapter or a script states only what the data cannot say (which group is the control,
@@ -17,15 +18,27 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
+from .._labels import label_columns
 from .nonparametric import ALTERNATIVES
-from .tables import _timepoint_key, check_cells
+from .tables import _label_tidy, _timepoint_key, check_cells
 
 __all__ = ["StudyDesign", "design_tables", "session_table", "study_design"]
 
 
+_SESSION_NAMES = {
+    "subject": "subject",
+    "group": "group",
+    "timepoint": "time point",
+    "status": "session status",
+    "error": "why the session failed",
+}
+
+
 def session_table(features) -> pd.DataFrame:
-    """One row per session of a cohort table: ``session`` (index), ``subject``,
-    ``group``, ``timepoint`` (strings) and ``status`` (``"ok"`` when absent).
+    """Return one row per session of a cohort table.
+
+    The row holds the session's ``subject``, ``group``, ``timepoint`` (strings),
+    ``status`` (``"ok"`` when absent) and ``error``, indexed by ``session``.
 
     Parameters
     ----------
@@ -36,6 +49,7 @@ def session_table(features) -> pd.DataFrame:
     Returns
     -------
     pandas.DataFrame
+        Index ``session``; text columns, labelled (``attrs["long_name"]``).
     """
     need = ["subject", "group", "timepoint"]
     if isinstance(features, xr.Dataset):
@@ -70,12 +84,17 @@ def session_table(features) -> pd.DataFrame:
         df["status"] = "ok"
     if "error" not in df:
         df["error"] = ""
-    return df
+    return label_columns(
+        df,
+        units=dict.fromkeys(df.columns, ""),
+        long_name={c: _SESSION_NAMES[c] for c in df.columns},
+    )
 
 
 def _names(given, present: list[str], what: str) -> list[str]:
-    """``given`` (a sequence of labels present in the data, in the order wanted) or
-    every label present; an unknown label is an error naming the known ones.
+    """Return the labels ``given``, or every label present.
+
+    ``given`` is a sequence of labels present in the data, in the order wanted; an unknown label is an error naming the known ones.
     """
     if given is None:
         return list(present)
@@ -94,8 +113,9 @@ def _names(given, present: list[str], what: str) -> list[str]:
 
 
 def _default_order(timepoints: list[str]) -> list[str]:
-    """'baseline' first, then durations (1h, 2d …) in time order; labels that do not
-    read as durations keep their order of appearance.
+    """Order time points: 'baseline' first, then durations (1h, 2d …) in time order.
+
+    Labels that do not read as durations keep their order of appearance.
     """
     rest = [t for t in timepoints if t != "baseline"]
     try:
@@ -143,9 +163,7 @@ class StudyDesign:
 
     @property
     def compared_timepoints(self) -> list[str]:
-        """Time points of the between-group tests: those after the baseline, or the
-        only one.
-        """
+        """Time points of the between-group tests: after the baseline, or the only one."""
         return [t for t in self.timepoints if t != self.baseline]
 
     @property
@@ -154,7 +172,7 @@ class StudyDesign:
         return self.baseline is not None and bool(self.compared_timepoints)
 
     def direction(self, feature: str) -> str:
-        """The alternative of ``feature``'s tests (``"two-sided"`` when not stated)."""
+        """Return the alternative of ``feature``'s tests (``"two-sided"`` when not stated)."""
         return self.directions.get(feature, "two-sided")
 
     def comparisons(self) -> list[tuple[str, str]]:
@@ -162,15 +180,15 @@ class StudyDesign:
         return [c for comps in self.families.values() for c in comps]
 
     def family_size(self, name: str) -> int:
-        """Tests in a family per feature: its comparisons × the compared time points."""
+        """Count the tests in a family per feature: its comparisons × the compared time points."""
         return len(self.families[name]) * len(self.compared_timepoints)
 
     def others(self) -> list[str]:
-        """The groups other than the control, in order."""
+        """Return the groups other than the control, in order."""
         return [g for g in self.groups if g != self.control]
 
     def describe(self) -> str:
-        """The design in words, from the data (group sizes, time points, tests)."""
+        """Describe the design in words, from the data (group sizes, time points, tests)."""
         sizes = self.animals.max(axis=1)
         groups = ", ".join(
             f"{g} ({int(sizes.get(g, 0))} animal{'s' if sizes.get(g, 0) != 1 else ''})"
@@ -212,7 +230,7 @@ def study_design(
     directions: Mapping[str, str] | None = None,
     families: Mapping[str, Sequence[Sequence[str]]] | None = None,
 ) -> StudyDesign:
-    """The design of a study from its cohort table and the choices the data cannot make.
+    """Read the design of a study from its cohort table and the choices the data cannot make.
 
     Parameters
     ----------
@@ -253,6 +271,7 @@ def study_design(
     Examples
     --------
     >>> import pandas as pd
+    >>> from tiltlab.stats import study_design
     >>> table = pd.DataFrame({"subject": ["a", "b", "c", "d"],
     ...                       "group": ["sham", "sham", "lesion", "lesion"],
     ...                       "timepoint": ["d7"] * 4, "x": [1.0, 2.0, 3.0, 4.0]})
@@ -315,6 +334,11 @@ def study_design(
         .astype(np.int64)
     )
     animals.index.name, animals.columns.name = "group", "time point"
+    animals = label_columns(
+        animals,
+        units="1",
+        long_name={t: f"animals at {t}" for t in animals.columns},
+    )
     return StudyDesign(
         groups=tuple(groups_),
         control=control_,
@@ -334,7 +358,7 @@ def design_tables(
     *,
     conf_level: float = 0.95,
 ) -> tuple[pd.DataFrame, pd.DataFrame | None]:
-    """The rank-test tables of one feature under a design.
+    """Compute the rank-test tables of one feature under a design.
 
     Between groups: one-sided Mann–Whitney tests (the feature's direction) for every
     comparison of every family at each compared time point, adjusted within each family
@@ -375,7 +399,8 @@ def design_tables(
         )
         part.insert(0, "family", name)
         parts.append(part)
-    between = pd.concat(parts, ignore_index=True)
+    units = parts[0].attrs["units"].get("hl", "")
+    between = _label_tidy(pd.concat(parts, ignore_index=True), units)
     within = None
     if design.longitudinal:
         within = against_baseline(

@@ -1,5 +1,6 @@
-r"""Effect sizes with confidence intervals: rank-biserial correlation, probability of
-superiority and the Hodges–Lehmann shift with its exact distribution-free interval.
+r"""Effect sizes with confidence intervals.
+
+Rank-biserial correlation, probability of superiority and the Hodges–Lehmann shift with its exact distribution-free interval.
 
 Two samples
 -----------

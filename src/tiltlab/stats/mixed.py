@@ -1,5 +1,6 @@
-r"""Longitudinal linear mixed model of one feature: group × time with a random intercept
-per subject, fitted by statsmodels ``MixedLM`` with its convergence checked.
+r"""Longitudinal linear mixed model of one feature.
+
+Group × time with a random intercept per subject, fitted by statsmodels ``MixedLM`` with its convergence checked.
 
 Model
 -----
@@ -45,6 +46,8 @@ import pandas as pd
 import statsmodels.formula.api as smf
 from scipy.stats import norm
 
+from .._labels import label_columns
+
 __all__ = ["MixedModelResult", "mixed_model"]
 
 _OPTIMIZERS = ("lbfgs", "bfgs", "powell", "nm")
@@ -52,7 +55,7 @@ _OPTIMIZERS = ("lbfgs", "bfgs", "powell", "nm")
 
 @dataclass
 class MixedModelResult:
-    """A fitted (or failed) mixed model.
+    r"""A fitted (or failed) mixed model.
 
     Attributes
     ----------
@@ -81,6 +84,31 @@ class MixedModelResult:
     residual_var: float = float("nan")
     formula: str = ""
     result: Any = None
+
+
+_MIXED_NAMES = {
+    "term": "fixed effect",
+    "estimate": "estimate",
+    "se": "standard error",
+    "z": "Wald z",
+    "p": "p (Wald, two-sided)",
+    "ci_low": "95% interval, lower bound",
+    "ci_high": "95% interval, upper bound",
+    "converged": "converged",
+}
+
+
+def _label_fixed(table: pd.DataFrame, units: str) -> pd.DataFrame:
+    """Label the fixed-effects table with units (those of the response) and long names."""
+    same = ("estimate", "se", "ci_low", "ci_high")
+    return label_columns(
+        table,
+        units={
+            c: units if c in same else ("1" if c in ("z", "p") else "") for c in table
+        },
+        long_name=_MIXED_NAMES,
+        role={"p": "p-value"},
+    )
 
 
 def _q(name: str) -> str:
@@ -184,11 +212,11 @@ def mixed_model(
             RuntimeWarning,
             stacklevel=2,
         )
-    cols = ["term", "estimate", "se", "z", "p", "ci_low", "ci_high", "converged"]
+    given = data.attrs.get("units", {})
+    units = str(given.get(feature, "")) if isinstance(given, dict) else ""
     if best is None:
-        return MixedModelResult(
-            pd.DataFrame(columns=cols), False, used, captured, formula=formula
-        )
+        empty = _label_fixed(pd.DataFrame(columns=list(_MIXED_NAMES)), units)
+        return MixedModelResult(empty, False, used, captured, formula=formula)
     fe = best.fe_params
     with np.errstate(all="ignore"):
         se = np.asarray(best.bse_fe, dtype=float)
@@ -207,6 +235,7 @@ def mixed_model(
             "converged": converged,
         }
     )
+    table = _label_fixed(table, units)
     table.attrs.update(
         converged=converged, optimizer=used, reference_group=g_ref, baseline=t_ref
     )

@@ -62,6 +62,7 @@ import pandas as pd
 from statsmodels.stats.multitest import multipletests
 
 from .. import _validate
+from .._labels import label_columns
 
 __all__ = [
     "ADJUSTMENTS",
@@ -128,7 +129,7 @@ def paper_bonferroni(p, family: int | None = None) -> np.ndarray:
 
 
 def adjust(p, method: str = "holm", *, family: int | None = None) -> np.ndarray:
-    r"""Adjusted p-values of one family of tests.
+    r"""Adjust the p-values of one family of tests.
 
     Parameters
     ----------
@@ -156,6 +157,16 @@ def adjust(p, method: str = "holm", *, family: int | None = None) -> np.ndarray:
         return a * m
     padded = np.concatenate([a, np.ones(m - a.size)])
     return multipletests(padded, method=ADJUSTMENTS[method])[1][: a.size]
+
+
+#: The columns :func:`add_adjustments` adds, with their long names.
+ADDED_COLUMNS = {
+    "family_size": "family size m",
+    "p_paper": "p × m (Fayat et al.)",
+    "p_bonferroni": "p, Bonferroni",
+    "p_holm": "p, Holm",
+    "p_bh": "p, Benjamini–Hochberg",
+}
 
 
 def _family_keys(table: pd.DataFrame, family) -> tuple[list[np.ndarray], int | None]:
@@ -188,7 +199,8 @@ def add_adjustments(
     Returns
     -------
     pandas.DataFrame
-        A copy with the five columns added.
+        A copy with the five columns added (dimensionless, with their long names in
+        ``attrs["long_name"]``; the p-value columns have role ``"p-value"``).
     """
     out = table.copy().reset_index(drop=True)
     p = out["p"].to_numpy(dtype=float)
@@ -206,4 +218,9 @@ def add_adjustments(
     out["family_size"] = size
     for k, v in cols.items():
         out[f"p_{k}"] = v
-    return out
+    return label_columns(
+        out,
+        units=dict.fromkeys(ADDED_COLUMNS, "1"),
+        long_name=ADDED_COLUMNS,
+        role={c: "count" if c == "family_size" else "p-value" for c in ADDED_COLUMNS},
+    )

@@ -75,6 +75,7 @@ import pandas as pd
 from scipy import stats as _st
 
 from .. import _validate
+from .._labels import label_columns
 
 __all__ = [
     "ALTERNATIVES",
@@ -211,14 +212,14 @@ def _sign_flip_counts(weights: np.ndarray) -> np.ndarray:
 
 @lru_cache(maxsize=256)
 def _mwu_counts_noties(n1: int, n2: int) -> np.ndarray:
-    """Counts of ``U = 0 .. n1 n2`` without ties (cached)."""
+    """Count the ``U = 0 .. n1 n2`` without ties (cached)."""
     c = _subset_sum_counts(np.arange(1, n1 + n2 + 1), n1)
     return np.ascontiguousarray(c[n1 * (n1 + 1) // 2 :])
 
 
 @lru_cache(maxsize=256)
 def _signed_rank_counts_noties(n: int) -> np.ndarray:
-    """Counts of ``T+ = 0 .. n(n+1)/2`` without ties (cached)."""
+    """Count the ``T+ = 0 .. n(n+1)/2`` without ties (cached)."""
     return _sign_flip_counts(np.arange(1, n + 1))
 
 
@@ -316,8 +317,9 @@ def _tie_term(ranks: np.ndarray) -> float:
 
 
 def _beyond_exact(test: str, why: str, requested: str) -> str:
-    """The note of an exact test replaced by the normal approximation (and a warning
-    when ``method="exact"`` was asked for explicitly).
+    """Write the note of an exact test replaced by the normal approximation.
+
+    Warn too when ``method="exact"`` was asked for explicitly.
     """
     note = (
         f"exact null distribution not computed ({why}); normal approximation used "
@@ -581,13 +583,21 @@ def _lattice(counts: np.ndarray, name: str) -> pd.DataFrame:
     k = np.rint(np.cumsum(counts[::-1])).astype(np.int64)  # k(s) = #{S >= s}
     s = np.arange(counts.size - 1, -1, -1)
     keep = counts[::-1] > 0
-    return pd.DataFrame(
-        {"statistic": s[keep], "k": k[keep], "p": k[keep] / total}
-    ).reset_index(drop=True)
+    table = pd.DataFrame({"statistic": s[keep], "k": k[keep], "p": k[keep] / total})
+    return label_columns(
+        table,
+        units="1",
+        long_name={
+            "statistic": "test statistic",
+            "k": "arrangements at least as extreme",
+            "p": "exact one-sided p",
+        },
+        role={"p": "p-value"},
+    )
 
 
 def exact_p_lattice(n1: int, n2: int) -> pd.DataFrame:
-    r"""The attainable exact one-sided Mann–Whitney p-values for groups of ``n1``, ``n2``.
+    r"""List the attainable exact one-sided Mann–Whitney p-values for groups of ``n1``, ``n2``.
 
     Parameters
     ----------
@@ -619,12 +629,12 @@ def exact_p_lattice(n1: int, n2: int) -> pd.DataFrame:
 
 
 def signed_rank_p_lattice(n: int) -> pd.DataFrame:
-    r"""The attainable exact one-sided signed-rank p-values for ``n`` differences.
+    r"""List the attainable exact one-sided signed-rank p-values for ``n`` differences.
 
     Parameters
     ----------
     n : int
-        Number of non-zero differences (no ties), at least 1.
+        How many differences (at least 1), none zero and none tied.
 
     Returns
     -------

@@ -50,6 +50,7 @@ import pandas as pd
 from scipy import stats as _st
 
 from .. import _validate
+from .._labels import label_columns
 from .nonparametric import (
     _alternative,
     _mwu_counts_noties,
@@ -73,7 +74,7 @@ _TESTS = ("mann-whitney", "wilcoxon")
 
 
 def normal_shift(shift: float, *, sd: float = 1.0) -> Simulator:
-    r"""A simulator of two normal groups: ``x ~ N(shift, sd²)``, ``y ~ N(0, sd²)``.
+    r"""Make a simulator of two normal groups: ``x ~ N(shift, sd²)``, ``y ~ N(0, sd²)``.
 
     Parameters
     ----------
@@ -99,8 +100,9 @@ def normal_shift(shift: float, *, sd: float = 1.0) -> Simulator:
 
 
 def observed_shift(x, y, *, scale: float = 1.0) -> Simulator:
-    r"""A simulator built from two observed groups: their spread, and their difference
-    in medians scaled by ``scale``.
+    r"""Make a simulator from two observed groups.
+
+    It keeps their spread, and their difference in medians scaled by ``scale``.
 
     Each simulated experiment resamples ``n`` animals with replacement from each
     group's residuals about its median (:math:`x_i - \tilde x`, :math:`y_j - \tilde
@@ -216,46 +218,92 @@ def _min_p(test: str, n: int) -> float:
     return float(c[-1] / c.sum())
 
 
-def _one_power(simulate_groups, n, test, alternative, threshold, n_sim, rng, method):
-    hits = 0
-    for _ in range(n_sim):
-        x, y = simulate_groups(n, rng)
-        try:
-            if test == "mann-whitney":
-                p = mann_whitney(x, y, alternative=alternative, method=method).p
-            else:
-                p = wilcoxon_signed_rank(x, y, alternative=alternative, method=method).p
-        except ValueError as exc:
-            if "n too small" not in str(exc):
-                raise
-            p = 1.0  # e.g. every difference zero: no evidence
-        hits += p <= threshold * (1 + 1e-12)
-    return hits / n_sim
+@dataclass(frozen=True)
+class _Setup:
+    """One simulated study design: the test, its level after the family, and B."""
+
+    test: str
+    alternative: str
+    threshold: float
+    n_sim: int
+    method: str
+
+    def power(self, simulate_groups: Simulator, n: int, rng) -> float:
+        """Return the rejection rate over ``n_sim`` experiments of ``n`` animals."""
+        hits = 0
+        test = mann_whitney if self.test == "mann-whitney" else wilcoxon_signed_rank
+        for _ in range(self.n_sim):
+            x, y = simulate_groups(n, rng)
+            try:
+                p = test(x, y, alternative=self.alternative, method=self.method).p
+            except ValueError as exc:
+                if "n too small" not in str(exc):
+                    raise
+                p = 1.0  # e.g. every difference zero: no evidence
+            hits += p <= self.threshold * (1 + 1e-12)
+        return hits / self.n_sim
 
 
-def _checked(alpha, family, n_sim, test, alternative):
-    a = _validate.fraction(alpha, "alpha", open_low=True, open_high=True)
-    m = _validate.integer(family, "family", minimum=1)
-    b = _validate.integer(n_sim, "n_sim", minimum=1)
-    if test not in _TESTS:
-        raise ValueError(f"test must be one of {_TESTS}, got {test!r}")
-    return a, m, b, _alternative(alternative)
+#: The simulation options shared by :func:`power_by_simulation` and
+#: :func:`animals_needed`, with their defaults.
+SIMULATION_OPTIONS = {
+    "alpha": 0.05,
+    "family": 1,
+    "n_sim": 1000,
+    "rng": None,
+    "test": "mann-whitney",
+    "alternative": "greater",
+    "method": "auto",
+}
+
+
+def _setup(options: dict, target_power) -> tuple[_Setup, float, int, float]:
+    """Check the simulation options; return the setup, alpha, m and the target."""
+    unknown = sorted(set(options) - set(SIMULATION_OPTIONS))
+    if unknown:
+        raise TypeError(
+            f"unknown option(s) {unknown}; the options are {list(SIMULATION_OPTIONS)}"
+        )
+    o = {**SIMULATION_OPTIONS, **options}
+    a = _validate.fraction(o["alpha"], "alpha", open_low=True, open_high=True)
+    m = _validate.integer(o["family"], "family", minimum=1)
+    b = _validate.integer(o["n_sim"], "n_sim", minimum=1)
+    if o["test"] not in _TESTS:
+        raise ValueError(f"test must be one of {_TESTS}, got {o['test']!r}")
+    alternative = _alternative(o["alternative"])
+    target = _validate.fraction(target_power, "target_power", open_low=True)
+    return _Setup(o["test"], alternative, a / m, b, o["method"]), a, m, target
+
+
+_POWER_LABELS = {
+    "n_per_group": ("animals per group", "1"),
+    "power": ("power", "1"),
+    "mc_se": ("Monte Carlo standard error of the power", "1"),
+    "threshold": ("level of each test α/m", "1"),
+    "min_p": ("smallest attainable exact p", "1"),
+    "attainable": ("α/m attainable", ""),
+    "n_sim": ("simulated experiments", "1"),
+}
+
+
+def _power_table(rows) -> pd.DataFrame:
+    table = pd.DataFrame(rows)
+    return label_columns(
+        table,
+        units={c: _POWER_LABELS[c][1] for c in table.columns},
+        long_name={c: _POWER_LABELS[c][0] for c in table.columns},
+        role={c: "p-value" for c in ("threshold", "min_p") if c in table.columns},
+    )
 
 
 def power_by_simulation(
     simulate_groups: Simulator,
     n_per_group: int | Sequence[int],
     *,
-    alpha: float = 0.05,
-    family: int = 1,
-    n_sim: int = 1000,
-    rng: int | np.random.Generator | None = None,
-    test: str = "mann-whitney",
-    alternative: str = "greater",
-    method: str = "auto",
     target_power: float = 0.8,
+    **options,
 ) -> pd.DataFrame:
-    r"""Power of a one-sided rank test after a Bonferroni family, by simulation.
+    r"""Estimate the power of a one-sided rank test after a Bonferroni family.
 
     Parameters
     ----------
@@ -264,70 +312,77 @@ def power_by_simulation(
         animals per group (paired samples for ``test="wilcoxon"``).
     n_per_group : int or sequence of int
         Group size(s) to evaluate (at least 2).
-    alpha : float
-        Family-wise level.
-    family : int
-        Bonferroni family size :math:`m`; each test runs at :math:`\alpha/m`.
-    n_sim : int
-        Simulated experiments per group size.
-    rng : int, numpy.random.Generator or None
-        Seed or generator.
-    test : {"mann-whitney", "wilcoxon"}
-        The test applied to ``(x, y)``.
-    alternative : {"greater", "less", "two-sided"}
-        Its alternative.
-    method : {"auto", "exact", "asymptotic"}
-        Passed to the test.
     target_power : float
         Power defining ``attrs["n_needed"]``.
+    **options
+        The simulation options (defaults in :data:`SIMULATION_OPTIONS`):
+        ``alpha`` (family-wise level, 0.05), ``family`` (Bonferroni family size
+        :math:`m`, 1; each test runs at :math:`\alpha/m`), ``n_sim`` (simulated
+        experiments per group size, 1000), ``rng`` (seed or generator), ``test``
+        (``"mann-whitney"`` or ``"wilcoxon"``, applied to ``(x, y)``),
+        ``alternative`` (``"greater"``, ``"less"`` or ``"two-sided"``) and
+        ``method`` (``"auto"``, ``"exact"`` or ``"asymptotic"``, passed to the test).
 
     Returns
     -------
     pandas.DataFrame
         One row per group size: ``n_per_group``, ``power``, ``mc_se``, ``threshold``
         (:math:`\alpha/m`), ``min_p`` (smallest attainable exact p without ties),
-        ``attainable`` (``min_p <= threshold``), ``n_sim``. ``attrs["n_needed"]`` is
-        the smallest evaluated size reaching ``target_power`` (None if none does).
+        ``attainable`` (``min_p <= threshold``), ``n_sim``, labelled
+        (``attrs["units"]``, ``attrs["long_name"]``). ``attrs["n_needed"]`` is the
+        smallest evaluated size reaching ``target_power`` (None if none does).
+
+    Raises
+    ------
+    TypeError
+        An unknown option.
     """
-    a, m, b, alternative = _checked(alpha, family, n_sim, test, alternative)
-    target = _validate.fraction(target_power, "target_power", open_low=True)
+    setup, a, m, target = _setup(options, target_power)
     ns = [n_per_group] if np.ndim(n_per_group) == 0 else list(n_per_group)
     if not ns:
         raise ValueError("n_per_group is empty")
     ns = [_validate.integer(n, "n_per_group", minimum=2) for n in ns]
-    gen = np.random.default_rng(rng)
+    gen = np.random.default_rng(options.get("rng"))
     rows = []
     for n in ns:
-        pw = _one_power(simulate_groups, n, test, alternative, a / m, b, gen, method)
-        min_p = _min_p(test, n)
+        pw = setup.power(simulate_groups, n, gen)
+        min_p = _min_p(setup.test, n)
         rows.append(
             {
                 "n_per_group": n,
                 "power": pw,
-                "mc_se": math.sqrt(max(pw * (1 - pw), 1e-300) / b),
-                "threshold": a / m,
+                "mc_se": math.sqrt(max(pw * (1 - pw), 1e-300) / setup.n_sim),
+                "threshold": setup.threshold,
                 "min_p": min_p,
-                "attainable": min_p <= a / m,
-                "n_sim": b,
+                "attainable": min_p <= setup.threshold,
+                "n_sim": setup.n_sim,
             }
         )
-    out = pd.DataFrame(rows)
+    out = _power_table(rows)
     ok = out.loc[out["power"] >= target, "n_per_group"]
     out.attrs.update(
         n_needed=int(ok.min()) if len(ok) else None,
         target_power=target,
         alpha=a,
         family=m,
-        test=test,
-        alternative=alternative,
+        test=setup.test,
+        alternative=setup.alternative,
     )
     return out
 
 
 @dataclass(frozen=True)
 class PowerResult:
-    """Animals per group needed: ``n`` (None if not reached by ``n_max``), its
-    simulated ``power`` and the ``table`` of every size evaluated.
+    """Animals per group needed (made by :func:`animals_needed`).
+
+    Attributes
+    ----------
+    n : int or None
+        Animals per group needed; None if not reached by ``n_max``.
+    power : float
+        Its simulated power.
+    table : pandas.DataFrame
+        Every size evaluated: ``n_per_group``, ``power``, ``mc_se`` (labelled).
     """
 
     n: int | None
@@ -339,38 +394,46 @@ def animals_needed(
     simulate_groups: Simulator,
     *,
     target_power: float = 0.8,
-    alpha: float = 0.05,
-    family: int = 1,
     n_min: int = 2,
     n_max: int = 100,
-    n_sim: int = 1000,
-    rng: int | np.random.Generator | None = None,
-    test: str = "mann-whitney",
-    alternative: str = "greater",
-    method: str = "auto",
+    **options,
 ) -> PowerResult:
-    r"""Smallest group size whose simulated power reaches ``target_power``.
+    r"""Find the smallest group size whose simulated power reaches ``target_power``.
 
     Doubles :math:`n` from ``n_min`` until the power reaches the target (or
     ``n_max``), then bisects between the last failing and the first passing size.
-    Parameters are those of :func:`power_by_simulation`.
+
+    Parameters
+    ----------
+    simulate_groups : callable
+        ``simulate_groups(n, rng) -> (x, y)``, as for :func:`power_by_simulation`.
+    target_power : float
+        The power to reach.
+    n_min, n_max : int
+        Smallest and largest group sizes tried.
+    **options
+        The simulation options of :func:`power_by_simulation` (``alpha``, ``family``,
+        ``n_sim``, ``rng``, ``test``, ``alternative``, ``method``).
 
     Returns
     -------
     PowerResult
+        The size needed, its power, and the table of every size evaluated.
+
+    Raises
+    ------
+    TypeError
+        An unknown option.
     """
-    a, m, b, alternative = _checked(alpha, family, n_sim, test, alternative)
-    target = _validate.fraction(target_power, "target_power", open_low=True)
+    setup, _, _, target = _setup(options, target_power)
     lo = _validate.integer(n_min, "n_min", minimum=2)
     hi_max = _validate.integer(n_max, "n_max", minimum=lo)
-    gen = np.random.default_rng(rng)
+    gen = np.random.default_rng(options.get("rng"))
     seen: dict[int, float] = {}
 
     def power(n: int) -> float:
         if n not in seen:
-            seen[n] = _one_power(
-                simulate_groups, n, test, alternative, a / m, b, gen, method
-            )
+            seen[n] = setup.power(simulate_groups, n, gen)
         return seen[n]
 
     n, fail = lo, lo - 1
@@ -386,8 +449,13 @@ def animals_needed(
                 n = mid
             else:
                 fail = mid
-    table = pd.DataFrame(
-        {"n_per_group": sorted(seen), "power": [seen[k] for k in sorted(seen)]}
+    sizes = sorted(seen)
+    pw = np.array([seen[k] for k in sizes])
+    table = _power_table(
+        {
+            "n_per_group": sizes,
+            "power": pw,
+            "mc_se": np.sqrt(pw * (1 - pw) / setup.n_sim),
+        }
     )
-    table["mc_se"] = np.sqrt(table["power"] * (1 - table["power"]) / b)
     return PowerResult(n, seen[n] if n is not None else float("nan"), table)

@@ -16,6 +16,8 @@ from __future__ import annotations
 
 import pandas as pd
 
+from .._labels import label_columns
+
 __all__ = [
     "FAYAT_DESIGN",
     "FAYAT_FEATURE_TABLES",
@@ -152,7 +154,7 @@ FAYAT_TABLES: dict[str, dict[str, tuple[str, ...]]] = {
 
 
 def fayat_table(name: str, *, columns=FAYAT_TIME_POINTS) -> pd.DataFrame:
-    """One of Fayat et al.'s printed tables as a DataFrame (comparisons × time points).
+    """Return one of Fayat et al.'s printed tables (comparisons × time points).
 
     Parameters
     ----------
@@ -160,11 +162,28 @@ def fayat_table(name: str, *, columns=FAYAT_TIME_POINTS) -> pd.DataFrame:
         ``"A1"`` or ``"A2"``.
     columns : sequence of str
         Labels for the six time points (default ``1h … 28d``).
+
+    Returns
+    -------
+    pandas.DataFrame
+        The printed m·p values as strings (``"<0.001"`` as printed), one row per
+        comparison, one column per time point; labelled (role ``"p-value"``).
+
+    Examples
+    --------
+    >>> fayat_table("A2").loc["Kainate vs. Kainate baseline", "1h"]
+    '<0.001'
     """
     if name not in FAYAT_TABLES:
         raise ValueError(f"name must be one of {sorted(FAYAT_TABLES)}, got {name!r}")
     if len(columns) != len(FAYAT_TIME_POINTS):
         raise ValueError(f"columns must name {len(FAYAT_TIME_POINTS)} time points")
-    return pd.DataFrame.from_dict(
+    table = pd.DataFrame.from_dict(
         FAYAT_TABLES[name], orient="index", columns=list(columns)
+    )
+    return label_columns(
+        table,
+        units="1",
+        long_name={c: f"p × m (printed), {c}" for c in table.columns},
+        role="p-value",
     )

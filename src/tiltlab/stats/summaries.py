@@ -14,6 +14,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from .._labels import label_columns
 from .effects import hodges_lehmann
 from .tables import format_table, long_table
 
@@ -43,8 +44,9 @@ def group_quantiles(features, feature: str, q=(0.25, 0.5, 0.75)) -> pd.DataFrame
     Returns
     -------
     pandas.DataFrame
-        Index (``group``, ``timepoint``), sorted; one column per probability in ``q``.
-        Missing values are left out; a cell without values is NaN.
+        Index (``group``, ``timepoint``), sorted; one column per probability in ``q``
+        (in the feature's units). Missing values are left out; a cell without values
+        is NaN.
 
     Examples
     --------
@@ -56,11 +58,15 @@ def group_quantiles(features, feature: str, q=(0.25, 0.5, 0.75)) -> pd.DataFrame
         raise ValueError(f"q must hold probabilities in [0, 1], got {q!r}")
     long = long_table(features, feature)
     out = long.groupby(["group", "timepoint"])["value"].quantile(probs).unstack()
-    return out.reindex(columns=probs)
+    return label_columns(
+        out.reindex(columns=probs),
+        units=long.attrs["units"]["value"],
+        long_name={p: f"{feature}, quantile {p:g}" for p in probs},
+    )
 
 
 def significant_cells(tidy: pd.DataFrame, column: str = "p_paper", alpha=0.05) -> str:
-    """The cells of a tidy table with ``column < alpha``, as one line of text.
+    """List the cells of a tidy table with ``column < alpha``, as one line of text.
 
     Parameters
     ----------
@@ -112,7 +118,7 @@ def with_published(tidy: pd.DataFrame, printed: pd.DataFrame | None = None):
         Index (``comparison``, ``p-values``) with the sources ``"Fayat et al.
         (printed)"`` (when shown), ``"m·p (ours)"`` and ``"Holm (ours)"`` for each
         comparison; columns the time points; cells formatted by
-        :func:`~tiltlab.stats.format_table`.
+        :func:`~tiltlab.stats.format_table` (strings; role ``"p-value"``).
 
     Examples
     --------
@@ -130,10 +136,22 @@ def with_published(tidy: pd.DataFrame, printed: pd.DataFrame | None = None):
     table = pd.concat(ours, names=["source", "comparison"])
     table = table.swaplevel().reindex(pd.MultiIndex.from_product([rows, list(ours)]))
     table.index.names = ["comparison", "p-values"]
-    return table
+    return label_columns(
+        table,
+        units="1",
+        long_name={c: f"p, {c}" for c in table.columns},
+        role="p-value",
+    )
 
 
-_RECOVERY = ("comparison", "time point", "planted Δ", "estimated Δ", "p (m·p)", "found")
+_RECOVERY = {
+    "comparison": "comparison",
+    "time point": "time point",
+    "planted Δ": "planted difference (Hodges–Lehmann)",
+    "estimated Δ": "estimated difference (Hodges–Lehmann)",
+    "p (m·p)": "p × m (Fayat et al.)",
+    "found": "found (p × m below the level)",
+}
 
 
 def recovery_table(
@@ -169,8 +187,9 @@ def recovery_table(
     Returns
     -------
     pandas.DataFrame
-        Columns ``comparison``, ``time point``, ``planted Δ``, ``estimated Δ``,
-        ``p (m·p)`` and ``found``, one row per comparison and time point.
+        Columns ``comparison``, ``time point``, ``planted Δ``, ``estimated Δ`` (in the
+        units of ``between``'s ``hl``), ``p (m·p)`` and ``found``, one row per
+        comparison and time point, labelled (``attrs["units"]``, ``attrs["long_name"]``).
     """
     _need(
         between,
@@ -194,4 +213,12 @@ def recovery_table(
                 "found": bool(r["p_paper"] < alpha),
             }
         )
-    return pd.DataFrame(out, columns=list(_RECOVERY))
+    units = between.attrs.get("units", {}).get("hl", "")
+    table = pd.DataFrame(out, columns=list(_RECOVERY))
+    return label_columns(
+        table,
+        units={"planted Δ": units, "estimated Δ": units, "p (m·p)": "1"}
+        | dict.fromkeys(["comparison", "time point", "found"], ""),
+        long_name=_RECOVERY,
+        role={"p (m·p)": "p-value"},
+    )

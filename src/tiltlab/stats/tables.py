@@ -1,5 +1,6 @@
-r"""Cohort glue and tables: the tests of every comparison × time point, tidy, and laid
-out like Fayat et al.'s Tables A1–A8.
+r"""Cohort glue and tables of the tests of every comparison × time point.
+
+Tidy, and laid out like Fayat et al.'s Tables A1–A8.
 
 Input is the cohort table of :func:`tiltlab.cohort.run_cohort` — an
 :class:`xarray.Dataset` with a ``session`` dimension, coordinates ``subject``,
@@ -54,13 +55,14 @@ import pandas as pd
 import xarray as xr
 
 from .. import _validate
+from .._labels import format_p, label_columns
 from .effects import (
     hodges_lehmann,
     paired_prob_superiority,
     paired_rank_biserial,
     prob_superiority,
 )
-from .multiple import add_adjustments
+from .multiple import ADDED_COLUMNS, add_adjustments
 from .nonparametric import _alternative, mann_whitney, wilcoxon_signed_rank
 
 __all__ = [
@@ -82,7 +84,9 @@ _UNIT_HOURS = {"min": 1 / 60, "h": 1.0, "d": 24.0, "w": 168.0}
 
 
 def _frame(features, feature: str) -> pd.DataFrame:
-    """Every session: ``session`` (None when the table has no ids), ``subject``,
+    """Return every session of a cohort table as a frame.
+
+    Columns ``session`` (None when the table has no ids), ``subject``,
     ``group``, ``timepoint``, ``value`` and ``status`` (``"ok"`` when absent).
     """
     need = ("subject", "group", "timepoint")
@@ -204,8 +208,14 @@ def long_table(features, feature: str, *, include_failed: bool = False) -> pd.Da
     keep = ["subject", "group", "timepoint", "value"]
     if include_failed:
         df.loc[df["status"] != "ok", "value"] = np.nan
-        return df[keep + ["status"]].reset_index(drop=True)
-    return df.loc[df["status"] == "ok", keep].reset_index(drop=True)
+        out = df[keep + ["status"]].reset_index(drop=True)
+    else:
+        out = df.loc[df["status"] == "ok", keep].reset_index(drop=True)
+    names = {"subject": "subject", "group": "group", "timepoint": "time point"}
+    names.update(value=feature, status="session status")
+    units = dict.fromkeys(out.columns, "")
+    units["value"] = _feature_units(features, feature)
+    return label_columns(out, units=units, long_name={c: names[c] for c in out.columns})
 
 
 def _timepoint_key(label) -> float:
@@ -255,6 +265,102 @@ def _effects_row(x, y, conf_level, paired, zero_method="wilcox") -> dict:
     }
 
 
+#: Long names of the tidy columns (:func:`between_groups`, :func:`against_baseline`).
+TIDY_LONG_NAMES = {
+    "family": "family of comparisons",
+    "feature": "feature",
+    "comparison": "comparison",
+    "group1": "group 1",
+    "group2": "group 2",
+    "timepoint": "time point",
+    "test": "test",
+    "n1": "n (group 1)",
+    "n2": "n (group 2)",
+    "n_missing": "sessions without a value",
+    "n_failed": "failed sessions",
+    "statistic": "test statistic",
+    "alternative": "alternative",
+    "method": "p-value method",
+    "p": "p",
+    **ADDED_COLUMNS,
+    "rbc": "rank-biserial correlation",
+    "rbc_low": "rank-biserial correlation, lower bound",
+    "rbc_high": "rank-biserial correlation, upper bound",
+    "ps": "probability of superiority",
+    "ps_low": "probability of superiority, lower bound",
+    "ps_high": "probability of superiority, upper bound",
+    "hl": "Hodges–Lehmann shift",
+    "hl_low": "Hodges–Lehmann shift, lower bound",
+    "hl_high": "Hodges–Lehmann shift, upper bound",
+    "hl_achieved": "achieved level of the shift interval",
+    "conf_level": "confidence level",
+    "note": "note",
+}
+_HL = ("hl", "hl_low", "hl_high")
+
+
+def _feature_units(features, feature: str) -> str:
+    """Return the units of a feature of a cohort table (``""`` when not stated).
+
+    Parameters
+    ----------
+    features : xarray.Dataset or pandas.DataFrame
+        The cohort table: a Dataset variable's ``attrs["units"]``, or a DataFrame's
+        ``attrs["units"][feature]``.
+    feature : str
+        The feature.
+
+    Returns
+    -------
+    str
+        Its units, ``""`` when the table does not say.
+
+    Examples
+    --------
+    >>> import pandas as pd
+    >>> df = pd.DataFrame({"x": [1.0]})
+    >>> df.attrs["units"] = {"x": "deg"}
+    >>> _feature_units(df, "x"), _feature_units(df, "y")
+    ('deg', '')
+    """
+    if isinstance(features, xr.Dataset) and feature in features.variables:
+        return str(features[feature].attrs.get("units", ""))
+    units = getattr(features, "attrs", {}).get("units", {})
+    return str(units.get(feature, "")) if isinstance(units, Mapping) else ""
+
+
+def _label_tidy(table: pd.DataFrame, units: str = "") -> pd.DataFrame:
+    """Return a tidy test table with the units and long names of its columns.
+
+    Parameters
+    ----------
+    table : pandas.DataFrame
+        A tidy table (columns among :data:`TIDY_LONG_NAMES`; others keep their name).
+    units : str
+        Units of the feature: those of the Hodges–Lehmann shift and its bounds.
+
+    Returns
+    -------
+    pandas.DataFrame
+        A labelled copy: counts, p-values and rank effect sizes dimensionless
+        (``"1"``), text columns ``""``, the p-value columns with role ``"p-value"``.
+    """
+    cols = list(table.columns)
+    text = (
+        "feature comparison group1 group2 timepoint test alternative method note family"
+    ).split()
+    return label_columns(
+        table,
+        units={c: units if c in _HL else ("" if c in text else "1") for c in cols},
+        long_name={c: TIDY_LONG_NAMES.get(c, str(c)) for c in cols},
+        role={
+            c: "p-value" if c == "p" or c.startswith("p_") else "count"
+            for c in cols
+            if c == "p" or c.startswith(("p_", "n1", "n2", "n_", "family_size"))
+        },
+    )
+
+
 _COLUMNS = (
     "feature comparison group1 group2 timepoint test n1 n2 n_missing n_failed statistic "
     "alternative method p rbc rbc_low rbc_high ps ps_low ps_high hl hl_low hl_high "
@@ -262,7 +368,7 @@ _COLUMNS = (
 ).split()
 
 
-def _finish(rows: list[dict], family) -> pd.DataFrame:
+def _finish(rows: list[dict], family, units: str = "") -> pd.DataFrame:
     table = pd.DataFrame(rows)
     for c in _COLUMNS:
         if c not in table.columns:
@@ -270,7 +376,18 @@ def _finish(rows: list[dict], family) -> pd.DataFrame:
     table = add_adjustments(table[_COLUMNS], family)
     front = _COLUMNS[: _COLUMNS.index("p") + 1]
     adj = ["family_size", "p_paper", "p_bonferroni", "p_holm", "p_bh"]
-    return table[front + adj + _COLUMNS[len(front) :]]
+    return _label_tidy(table[front + adj + _COLUMNS[len(front) :]], units)
+
+
+def _checked_options(conf_level, test_options) -> float:
+    """Check the effect-size level and the test options; return the level."""
+    unknown = sorted(set(test_options) - {"method", "exact_max_n"})
+    if unknown:
+        raise TypeError(
+            f"unknown test option(s) {unknown}; the options are 'method' and "
+            "'exact_max_n'"
+        )
+    return _validate.fraction(conf_level, "conf_level", open_low=True, open_high=True)
 
 
 def between_groups(
@@ -283,8 +400,7 @@ def between_groups(
     baseline: str = "baseline",
     family: int | str | Sequence[str] | None = None,
     conf_level: float = 0.95,
-    method: str = "auto",
-    exact_max_n: int = 8,
+    **test_options,
 ) -> pd.DataFrame:
     r"""One-sided Mann–Whitney tests between groups at each time point.
 
@@ -311,8 +427,8 @@ def between_groups(
         time points per lesion type.
     conf_level : float
         Level of the effect-size intervals.
-    method, exact_max_n
-        See :func:`tiltlab.stats.mann_whitney`.
+    **test_options
+        ``method`` and ``exact_max_n`` of :func:`tiltlab.stats.mann_whitney`.
 
     Returns
     -------
@@ -325,10 +441,27 @@ def between_groups(
     ValueError
         Two sessions of one subject at one time point (:func:`check_cells`), a group
         absent from the data, a comparison without a direction.
+    TypeError
+        An unknown test option.
+
+    Examples
+    --------
+    >>> import pandas as pd
+    >>> from tiltlab.stats import between_groups
+    >>> table = pd.DataFrame({
+    ...     "subject": [f"s{i}" for i in range(8)],
+    ...     "group": ["lesion"] * 4 + ["sham"] * 4,
+    ...     "timepoint": ["7d"] * 8,
+    ...     "tilt": [9.0, 8.0, 7.5, 9.5, 5.0, 6.0, 5.5, 4.0],
+    ... })
+    >>> tidy = between_groups(table, "tilt", [("lesion", "sham", "greater")])
+    >>> tidy[["comparison", "timepoint", "n1", "n2", "p", "hl"]].round(4)
+            comparison timepoint  n1  n2       p   hl
+    0  lesion vs. sham        7d   4   4  0.0143  3.5
+    >>> tidy.attrs["long_name"]["hl"]
+    'Hodges–Lehmann shift'
     """
-    conf_level = _validate.fraction(
-        conf_level, "conf_level", open_low=True, open_high=True
-    )
+    conf_level = _checked_options(conf_level, test_options)
     full = _frame(features, feature)
     check_cells(full)
     ok = full["status"] == "ok"
@@ -386,9 +519,7 @@ def between_groups(
                 "note": "",
             }
             try:
-                res = mann_whitney(
-                    x, y, alternative=alt, method=method, exact_max_n=exact_max_n
-                )
+                res = mann_whitney(x, y, alternative=alt, **test_options)
             except ValueError as exc:
                 row["note"] = f"not tested: {exc}"
                 rows.append(row)
@@ -396,7 +527,7 @@ def between_groups(
             row.update(statistic=res.statistic, method=res.method, p=res.p)
             row.update(_effects_row(x, y, conf_level, paired=False))
             rows.append(row)
-    return _finish(rows, family)
+    return _finish(rows, family, _feature_units(features, feature))
 
 
 def against_baseline(
@@ -410,8 +541,7 @@ def against_baseline(
     family: int | str | Sequence[str] | None = "group1",
     zero_method: str = "wilcox",
     conf_level: float = 0.95,
-    method: str = "auto",
-    exact_max_n: int = 50,
+    **test_options,
 ) -> pd.DataFrame:
     r"""One-sided Wilcoxon signed-rank tests of each time point against baseline.
 
@@ -438,9 +568,10 @@ def against_baseline(
     zero_method : {"wilcox", "pratt"}
         Zero-difference rule (:func:`tiltlab.stats.wilcoxon_signed_rank`).
     conf_level : float
-        Level of the effect-size intervals.
-    method, exact_max_n
-        See :func:`tiltlab.stats.wilcoxon_signed_rank`.
+        Confidence level of the intervals around the effect sizes.
+    **test_options
+        The signed-rank test's ``method`` and ``exact_max_n``
+        (:func:`tiltlab.stats.wilcoxon_signed_rank`).
 
     Returns
     -------
@@ -456,9 +587,7 @@ def against_baseline(
         Two sessions of one subject at one time point (:func:`check_cells`), a group
         or the baseline absent from the data, a group without a direction.
     """
-    conf_level = _validate.fraction(
-        conf_level, "conf_level", open_low=True, open_high=True
-    )
+    conf_level = _checked_options(conf_level, test_options)
     full = _frame(features, feature)
     check_cells(full)
     ok = full["status"] == "ok"
@@ -524,12 +653,7 @@ def against_baseline(
             row.update(n1=x.size, n2=x.size, n_missing=len(incomplete))
             try:
                 res = wilcoxon_signed_rank(
-                    x,
-                    y,
-                    alternative=alts[g],
-                    zero_method=zero_method,
-                    method=method,
-                    exact_max_n=exact_max_n,
+                    x, y, alternative=alts[g], zero_method=zero_method, **test_options
                 )
             except ValueError as exc:
                 row["note"] = f"not tested: {exc}"
@@ -542,18 +666,11 @@ def against_baseline(
                 _effects_row(x, y, conf_level, paired=True, zero_method=zero_method)
             )
             rows.append(row)
-    return _finish(rows, family)
+    return _finish(rows, family, _feature_units(features, feature))
 
 
 def _stars(v: float) -> str:
     return "*" * sum(v < t for t in THRESHOLDS) if np.isfinite(v) else ""
-
-
-def _fmt(v: float, decimals: int) -> str:
-    if not np.isfinite(v):
-        return ""
-    small = 10.0**-decimals
-    return f"<{small:.{decimals}f}" if v < small else f"{v:.{decimals}f}"
 
 
 def format_table(
@@ -602,10 +719,16 @@ def format_table(
         dropna=False,
     ).reindex(index=rows, columns=cols)
     grid.index.name, grid.columns.name = None, None
-    if output == "frame":
-        return grid
     is_p = value == "p" or value.startswith("p_")
-    text = grid.map(lambda v: _fmt(v, decimals))
+    if output == "frame":
+        units = tidy.attrs.get("units", {})
+        return label_columns(
+            grid,
+            units="1" if is_p else str(units.get(value, "")),
+            long_name={c: f"{TIDY_LONG_NAMES.get(value, value)}, {c}" for c in cols},
+            role="p-value" if is_p else None,
+        )
+    text = grid.map(lambda v: format_p(v, decimals))
     if output == "text":
         return text + grid.map(_stars) if is_p else text
 
