@@ -197,7 +197,8 @@ def glossary() -> tuple[str, list[str]]:
     rows = []
     for name in sorted(users, key=str.lower):
         texts = meaning.get(name) or ["(undocumented)"]
-        text = max(set(texts), key=lambda t: (texts.count(t), -len(t)))
+        # the most used description; ties: the shorter, then alphabetical
+        text = min(set(texts), key=lambda t: (-texts.count(t), len(t), t))
         used = sorted(set(users[name]))
         where = ", ".join(f"`{u}`" for u in used[:3])
         if len(used) > 3:
