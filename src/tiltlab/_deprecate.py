@@ -13,6 +13,8 @@ import warnings
 from collections.abc import Callable
 from typing import Any, TypeVar
 
+from ._stack import user_stacklevel
+
 F = TypeVar("F", bound=Callable[..., Any])
 
 __all__ = ["alias", "renamed"]
@@ -60,7 +62,7 @@ def renamed(**old_to_new: str) -> Callable[[F], F]:
                         f"{func.__name__}: {old!r} was renamed {new!r}; the old "
                         "name goes in the next release",
                         FutureWarning,
-                        stacklevel=2,
+                        stacklevel=user_stacklevel(),
                     )
                     kwargs[new] = kwargs.pop(old)
             return func(*args, **kwargs)
@@ -107,7 +109,7 @@ def alias(func: F, old_name: str) -> F:
             f"{old_name} was renamed {func.__name__}; the old name goes in the next "
             "release",
             FutureWarning,
-            stacklevel=2,
+            stacklevel=user_stacklevel(),
         )
         return func(*args, **kwargs)
 

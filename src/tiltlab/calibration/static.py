@@ -35,6 +35,7 @@ from typing import NamedTuple
 import numpy as np
 import xarray as xr
 
+from .._stack import user_stacklevel
 from .. import _validate as _v
 from .. import units as _units
 from .._deprecate import renamed
@@ -230,7 +231,7 @@ def robust_gyro_offset(
             )
             if on_rotation == "raise":
                 raise CalibrationError(msg)
-            warnings.warn(msg, QualityWarning, stacklevel=2)
+            warnings.warn(msg, QualityWarning, stacklevel=user_stacklevel())
     return offset
 
 

@@ -28,6 +28,7 @@ from typing import Any, NamedTuple
 
 import pandas as pd
 
+from .._stack import user_stacklevel
 from .. import io as _io
 from .manifest import _RESTART_INIT, Manifest, StudyLabels, _check_table, _portable
 from .sessions import READERS, session_path
@@ -194,7 +195,7 @@ def _old_label_keywords(func):
                 "declared=StudyLabels(groups=..., timepoints=...); the old keywords go "
                 "in the next release",
                 FutureWarning,
-                stacklevel=2,
+                stacklevel=user_stacklevel(),
             )
             kwargs["declared"] = StudyLabels(**old)
         return func(*args, **kwargs)

@@ -60,6 +60,7 @@ from typing import Any
 
 import pandas as pd
 
+from .._stack import user_stacklevel
 from ..datasets import file_sha256
 from .sessions import (
     _CALIBRATION_READERS,
@@ -595,5 +596,5 @@ def _warn_near_duplicates(column, what: str, keyword: str, where: str) -> None:
                     f"Declare the study's {what} ({keyword}, or --{keyword[:-1]} on "
                     "the command line) to make an undeclared label an error",
                     ManifestWarning,
-                    stacklevel=3,
+                    stacklevel=user_stacklevel(),
                 )

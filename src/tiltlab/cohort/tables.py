@@ -81,6 +81,7 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
+from .._stack import user_stacklevel
 from .run import _write_atomically
 
 __all__ = [
@@ -567,7 +568,7 @@ def _read_csv(path: Path) -> pd.DataFrame:
             f"{path}: no data dictionary {side.name} beside it; units and long names "
             "are unknown and the column types are guessed",
             UserWarning,
-            stacklevel=3,
+            stacklevel=user_stacklevel(),
         )
         dictionary = {}
     columns = {}

@@ -47,6 +47,7 @@ the tilt difference between two methods, errors pooled over recordings) and
 
 import warnings as _warnings
 
+from .._stack import user_stacklevel
 from .errors import (
     FAYAT_TABLE1,
     MOTION_STATES,
@@ -88,7 +89,7 @@ def __getattr__(name: str):
             "tiltlab.evaluate.STATES was renamed MOTION_STATES (tiltlab.simulate.STATES "
             "is another thing); the old name goes in the next release",
             FutureWarning,
-            stacklevel=2,
+            stacklevel=user_stacklevel(),
         )
         return MOTION_STATES
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -18,6 +18,7 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
+from .._stack import user_stacklevel
 from .. import _validate as _v
 from ..quaternion import gravity  # one function, labelled or plain (re-exported)
 from .._deprecate import alias, renamed
@@ -350,7 +351,7 @@ def estimate(
                 f"segment{'s' if short != 1 else ''} shorter than min_segment_s = "
                 f"{min_segment_s:g} s)",
                 RuntimeWarning,
-                stacklevel=2,
+                stacklevel=user_stacklevel(),
             )
         attrs.update(
             gaps=gaps,

@@ -36,6 +36,7 @@ from typing import Any
 
 import numpy as np
 
+from .._stack import user_stacklevel
 from .. import _validate as _v
 from .. import dsp
 import tiltlab.filters.adapters as adapters
@@ -239,7 +240,7 @@ def _current_names(function: Callable[..., Any], params: Mapping[str, Any]) -> d
                 f"{function.__name__}: {k!r} was renamed {new!r}; the old name goes "
                 "in the next release",
                 FutureWarning,
-                stacklevel=4,
+                stacklevel=user_stacklevel(),
             )
             k = new
         out[k] = v

@@ -31,6 +31,7 @@ Supported formats
 
 from __future__ import annotations
 
+from .._stack import user_stacklevel
 from ._common import IntegrityError, ReadError
 from .broad import read_broad
 from .check import try_read
@@ -94,7 +95,7 @@ def __getattr__(name: str):
             "tiltlab.io.GAP_POLICIES was renamed READ_GAP_POLICIES; the old name goes "
             "in the next release",
             FutureWarning,
-            stacklevel=2,
+            stacklevel=user_stacklevel(),
         )
         return READ_GAP_POLICIES
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

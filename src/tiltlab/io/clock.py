@@ -21,6 +21,7 @@ from typing import Any
 
 import numpy as np
 
+from .._stack import user_stacklevel
 from .. import _validate
 from .. import quality as _quality
 from .. import schema
@@ -586,7 +587,7 @@ def warn_if_downsampled(fs: float, fs_source: float, what: str) -> None:
             f"content above {fs / 2:.4g} Hz aliases. Low-pass filter first, or keep the "
             "native rate",
             _quality.QualityWarning,
-            stacklevel=3,
+            stacklevel=user_stacklevel(),
         )
 
 

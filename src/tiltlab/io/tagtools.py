@@ -21,6 +21,7 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
+from .._stack import user_stacklevel
 import tiltlab._deprecate as _deprecate
 from .. import schema
 from ..quality import QualityWarning
@@ -343,7 +344,7 @@ def _same_length(
         f"{path.name}: sensors differ in length by "
         f"{max(lengths.values()) - n} sample(s) ({listed}); kept the first {n}",
         QualityWarning,
-        stacklevel=3,
+        stacklevel=user_stacklevel(),
     )
     return {r: v[:n] for r, v in data.items()}
 

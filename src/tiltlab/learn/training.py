@@ -36,6 +36,7 @@ from typing import Any
 import numpy as np
 import torch
 
+from .._stack import user_stacklevel
 from .. import _deprecate
 from .. import _validate as _v
 from ..datasets import file_sha256
@@ -648,7 +649,7 @@ def load_model(
         warnings.warn(
             f"{path}: no recorded sha256 (no SHA256SUMS entry, saved before tiltlab "
             "stored one): the weights are not checked",
-            stacklevel=2,
+            stacklevel=user_stacklevel(),
         )
     cfg = TrainConfig.from_dict(blob["config"])
     model = build_model(cfg, blob["fs"])

@@ -2,13 +2,12 @@
 
 from __future__ import annotations
 
-import os
-import sys
 import warnings
 from collections.abc import Sequence
 
 import xarray as xr
 
+from .._stack import user_stacklevel
 from .._deprecate import renamed
 from ._common import (
     Finding,
@@ -98,19 +97,6 @@ def assess(
     return out
 
 
-def _stacklevel() -> int:
-    """Return the stack level of the first caller outside tiltlab, for :func:`emit`."""
-    pkg = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))  # tiltlab
-    frame = sys._getframe(1)  # emit
-    level = 1
-    while frame.f_back is not None and os.path.abspath(
-        frame.f_code.co_filename
-    ).startswith(pkg + os.sep):
-        frame = frame.f_back
-        level += 1
-    return level
-
-
 def emit(findings: Sequence[Finding]) -> None:
     """Raise the error findings, else warn each warning as a :class:`QualityWarning`.
 
@@ -128,6 +114,6 @@ def emit(findings: Sequence[Finding]) -> None:
     errors = [f for f in findings if f.is_error]
     if errors:
         raise UnitCheckError(errors)
-    level = _stacklevel()
+    level = user_stacklevel()
     for f in findings:
         warnings.warn(f.message, QualityWarning, stacklevel=level)

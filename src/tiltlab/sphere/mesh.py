@@ -67,6 +67,7 @@ import xarray as xr
 from numba import njit, prange
 from scipy.spatial import ConvexHull
 
+from .._stack import user_stacklevel
 from .. import _validate
 from .._validate import RecordingError
 from ..frames import fibonacci_lattice
@@ -661,7 +662,7 @@ def tilt_map(
         warnings.warn(
             f"tilt_map: {reason}; the map is empty (count 0, fraction and density NaN)",
             RuntimeWarning,
-            stacklevel=2,
+            stacklevel=user_stacklevel(),
         )
     with np.errstate(invalid="ignore", divide="ignore"):
         frac = counts / total if total else np.full(counts.shape, np.nan)

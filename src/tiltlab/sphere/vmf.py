@@ -42,6 +42,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from .._stack import user_stacklevel
 from .. import _validate
 from .mesh import _read, as_unit_vectors
 
@@ -340,7 +341,7 @@ def vmf_fit(x, weights=None) -> VMFFit:
             f"vmf_fit: {what} (mean resultant length 1): the concentration "
             "estimate kappa is infinite",
             RuntimeWarning,
-            stacklevel=2,
+            stacklevel=user_stacklevel(),
         )
     return VMFFit(s / rn, kappa, rbar, n)
 

@@ -46,6 +46,7 @@ import pandas as pd
 import statsmodels.formula.api as smf
 from scipy.stats import norm
 
+from .._stack import user_stacklevel
 from .._labels import label_columns
 
 __all__ = ["MixedModelResult", "mixed_model"]
@@ -210,7 +211,7 @@ def mixed_model(
             f"MixedLM for {feature!r} did not converge with any of "
             f"{list(optimizers)}; see MixedModelResult.warnings",
             RuntimeWarning,
-            stacklevel=2,
+            stacklevel=user_stacklevel(),
         )
     given = data.attrs.get("units", {})
     units = str(given.get(feature, "")) if isinstance(given, dict) else ""

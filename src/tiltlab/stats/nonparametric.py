@@ -74,6 +74,7 @@ import numpy as np
 import pandas as pd
 from scipy import stats as _st
 
+from .._stack import user_stacklevel
 from .. import _validate
 from .._labels import label_columns
 
@@ -330,7 +331,7 @@ def _beyond_exact(test: str, why: str, requested: str) -> str:
             f"{test}: method='exact' is beyond the exact range ({why}); the asymptotic "
             "p-value is returned (result.method and result.note say so)",
             RuntimeWarning,
-            stacklevel=3,
+            stacklevel=user_stacklevel(),
         )
     return note
 

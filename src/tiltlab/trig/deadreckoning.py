@@ -11,6 +11,7 @@ import warnings
 
 import numpy as np
 
+from .._stack import user_stacklevel
 import tiltlab._validate as _v
 from ..frames import _vec3, unit_vector, wrap_angle
 
@@ -91,7 +92,7 @@ def local_to_lonlat(
             f"local_to_lonlat: {int(np.sum(pole))} step(s) centred on a pole, where "
             "the longitude is undefined; set to NaN",
             RuntimeWarning,
-            stacklevel=2,
+            stacklevel=user_stacklevel(),
         )
     with np.errstate(divide="ignore", invalid="ignore"):
         lon = np.asarray(lon0, float) + np.asarray(x, float) / (radius * c)

@@ -16,6 +16,7 @@ import warnings
 
 import numpy as np
 
+from .._stack import user_stacklevel
 import tiltlab._validate as _v
 from ..frames import (
     R1,
@@ -60,7 +61,7 @@ def _warn_undefined(where: str, bad: np.ndarray, total: int, why: str) -> None:
     warnings.warn(
         f"{where}: {int(np.sum(bad))} of {total} samples set to NaN: {why}",
         RuntimeWarning,
-        stacklevel=5,
+        stacklevel=user_stacklevel(),
     )
 
 

@@ -11,6 +11,7 @@ import warnings
 
 import numpy as np
 
+from .._stack import user_stacklevel
 import tiltlab._validate as _v
 from ..frames import Convention, _as_benhamou, _clip1, _elev_bank, acc_from_angles
 from ._common import angle_function, label, read_input
@@ -91,7 +92,7 @@ def _nan_where_zero(V, where: str, name: str, *angles):
         f"{where}: {int(np.sum(zero))} of {zero.size} samples of {name} are zero "
         "vectors, whose direction (hence every angle) is undefined; set to NaN",
         RuntimeWarning,
-        stacklevel=3,
+        stacklevel=user_stacklevel(),
     )
     return tuple(np.where(zero, np.nan, a) for a in angles)
 
