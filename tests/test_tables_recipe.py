@@ -180,3 +180,23 @@ def test_a_two_dimensional_dataarray_renders_as_a_matrix():
     assert out.columns.name == "median tilt error [deg], by speed [deg/s]"
     assert list(out.columns) == ["25.00", "75.00"]
     assert out.index.name == "estimator"
+
+
+def test_long_definitions_go_to_the_caption():
+    import pandas as pd
+
+    from tiltlab import plot
+    from tiltlab._labels import label_columns
+
+    definition = "fraction of time immobile (angular speed below 12 deg/s, merged)"
+    df = label_columns(
+        pd.DataFrame({"immobile_fraction": [0.25], "rmse": [1.0]}),
+        units={"immobile_fraction": "1", "rmse": "deg"},
+        long_name={"immobile_fraction": definition, "rmse": "tilt RMSE"},
+    )
+    assert list(plot.table(df, output="frame").columns) == [
+        "immobile_fraction",
+        "tilt RMSE [deg]",
+    ]
+    html = plot.table(df, caption="Sessions").to_html()
+    assert f"Sessions. immobile_fraction: {definition}" in html

@@ -64,7 +64,7 @@ from .recording import (
     speed_trace,
 )
 from .scores import binned_errors, ecdf_plot, score_curves, score_heatmap, trial_bars
-from .tables import DECIMALS, MISSING, P_DECIMALS, table
+from .tables import DECIMALS, MAX_HEADER, MISSING, P_DECIMALS, table
 
 from .cohort import __all__ as _cohort_all
 from .filters import __all__ as _filters_all

@@ -29,7 +29,7 @@ import xarray as xr
 
 from .._labels import format_p
 
-__all__ = ["DECIMALS", "MISSING", "P_DECIMALS", "table"]
+__all__ = ["DECIMALS", "MAX_HEADER", "MISSING", "P_DECIMALS", "table"]
 
 #: Decimals shown per units (the one table of rounding rules); units not listed show
 #: three significant digits.
@@ -57,6 +57,9 @@ DECIMALS = {
 P_DECIMALS = 3
 #: How a missing value is shown.
 MISSING = "–"
+#: A long name longer than this (characters) is a definition, not a header: the
+#: column is headed by its name and the definition goes to the caption.
+MAX_HEADER = 48
 
 _P_NAME = re.compile(r"^p($|_| \()")
 
@@ -220,6 +223,9 @@ def table(
         name is headed by its name.
     caption : str, optional
         The table's caption (``None``: none; ``"no result"`` for an absent result).
+        Long names longer than :data:`MAX_HEADER` characters are definitions: those
+        columns are headed by their names and the definitions are added to the
+        caption.
     decimals : int or mapping, optional
         Decimals of every numeric column, or per column (column → int); default by
         units (:data:`DECIMALS`). p-values always show :data:`P_DECIMALS`.
@@ -261,7 +267,16 @@ def table(
         )
         cells[name] = [fmt(v) for v in df[name].tolist()]
     text = pd.DataFrame(cells, index=_formatted_index(df.index, units, long))
-    headers = [_header(c, units, long, role.get(c) == "matrix") for c in df.columns]
+    defined = {
+        c: long[c]
+        for c in df.columns
+        if not isinstance(c, tuple) and len(str(long.get(c) or "")) > MAX_HEADER
+    }
+    short = {c: n for c, n in long.items() if c not in defined}
+    headers = [_header(c, units, short, role.get(c) == "matrix") for c in df.columns]
+    if defined:
+        notes = "; ".join(f"{c}: {text}" for c, text in defined.items())
+        caption = f"{caption}. {notes}" if caption else notes
     seen: set = set()
     for i, h in enumerate(headers):
         if h in seen:  # two columns, one long name: tell them apart
