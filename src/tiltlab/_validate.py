@@ -83,6 +83,8 @@ def vectors(
     ndim: int | None = 2,
     allow_nan: bool = False,
     min_length: int = 0,
+    copy: bool = True,
+    check_values: bool = True,
 ) -> np.ndarray:
     """Return a float copy of ``a`` checked for shape and finiteness.
 
@@ -100,11 +102,17 @@ def vectors(
         Accept NaN (never ±inf).
     min_length : int
         Minimum size of the first dimension.
+    copy : bool
+        ``False``: a C-contiguous float64 ``a`` is returned as it is (no copy), for
+        callers that only read it; otherwise converted.
+    check_values : bool
+        ``False``: skip the finiteness check (the caller scans the values itself,
+        e.g. in one compiled pass).
 
     Returns
     -------
     numpy.ndarray of float
-        A new array (never a view of ``a``).
+        A new array (never a view of ``a``), unless ``copy=False``.
 
     Raises
     ------
@@ -119,7 +127,11 @@ def vectors(
         raise ValueError(f"{name} must be numeric, got {type(a).__name__}") from None
     _not_complex(raw, name)
     try:
-        x = np.array(raw, dtype=float)
+        x = (
+            np.array(raw, dtype=float)
+            if copy
+            else np.ascontiguousarray(raw, dtype=np.float64)
+        )
     except (TypeError, ValueError):
         raise ValueError(f"{name} must be numeric, got {type(a).__name__}") from None
     if ndim is not None and x.ndim != ndim:
@@ -133,6 +145,8 @@ def vectors(
         raise ValueError(
             f"{name} needs at least {min_length} samples, got {x.shape[0]}"
         )
+    if not check_values:
+        return x
     bad = ~np.isfinite(x) if not allow_nan else np.isinf(x)
     if bad.any():
         what = "non-finite" if not allow_nan else "infinite"

@@ -24,6 +24,7 @@ import xarray as xr
 from .. import _validate as _v
 from .. import quaternion as quat
 from .. import units as _units
+from ._shared_kernel import _scan_samples
 
 __all__ = [
     "check_tuning",
@@ -42,10 +43,42 @@ __all__ = [
 F = TypeVar("F", bound=Callable[..., Any])
 
 
+def _checked(a, name: str, n: int | None, nonzero: bool | None):
+    """Return ``(samples, largest absolute value)``; see :func:`samples`."""
+    x = _v.vectors(a, name, width=3, ndim=2, copy=False, check_values=False)
+    if x.shape[0] == 0:
+        raise ValueError(
+            f"{name} is empty (0 samples); the filters need at least one sample"
+        )
+    # two vectorised reductions, no temporary: NaN and ±inf show in the extremes;
+    # the values are counted (one compiled pass) only when something is wrong
+    hi, lo = float(x.max()), float(x.min())
+    if np.isfinite(hi) and np.isfinite(lo):
+        n_nan, n_inf, nonzero_seen, peak = 0, 0, hi != 0.0 or lo != 0.0, max(hi, -lo)
+    else:
+        n_nan, n_inf, nonzero_seen, peak = _scan_samples(x)
+    if n_inf:
+        raise ValueError(f"{name} has {n_inf} infinite values")
+    if n_nan:
+        raise ValueError(
+            f"{name} has {n_nan} NaN values; the filters need finite samples "
+            "(interpolate or split the recording)"
+        )
+    if n is not None and x.shape[0] != n:
+        raise ValueError(f"{name} has {x.shape[0]} samples, expected {n}")
+    if (name == "acc" if nonzero is None else nonzero) and not nonzero_seen:
+        what = "; no gravity direction can be defined" if name == "acc" else ""
+        raise ValueError(
+            f"{name} is zero in all {x.shape[0]} samples (a disconnected or "
+            f"zero-filled sensor?){what}"
+        )
+    return x, float(peak)
+
+
 def samples(
     a, name: str, n: int | None = None, *, nonzero: bool | None = None
 ) -> np.ndarray:
-    """Return a contiguous float (N, 3) copy of ``a``, refusing bad samples by name.
+    """Return ``a`` as contiguous float (N, 3) samples, refusing bad samples by name.
 
     Refused (a ValueError naming ``name``): a wrong shape, no samples at all, NaN or infinite values (the filters need
     finite samples: interpolate or split the recording, e.g. with
@@ -68,28 +101,11 @@ def samples(
     Returns
     -------
     numpy.ndarray, shape (N, 3)
-        A contiguous float64 copy.
+        Contiguous float64 samples: ``a`` itself when it already is such an array
+        (the filters only read it), else a converted copy. Checked in one compiled
+        pass (finiteness, an all-zero sensor).
     """
-    x = _v.vectors(a, name, width=3, ndim=2, allow_nan=True)
-    if x.shape[0] == 0:
-        raise ValueError(
-            f"{name} is empty (0 samples); the filters need at least one sample"
-        )
-    k = int(np.isnan(x).sum())
-    if k:
-        raise ValueError(
-            f"{name} has {k} NaN values; the filters need finite samples "
-            "(interpolate or split the recording)"
-        )
-    if n is not None and x.shape[0] != n:
-        raise ValueError(f"{name} has {x.shape[0]} samples, expected {n}")
-    if (name == "acc" if nonzero is None else nonzero) and not np.any(x):
-        what = "; no gravity direction can be defined" if name == "acc" else ""
-        raise ValueError(
-            f"{name} is zero in all {x.shape[0]} samples (a disconnected or "
-            f"zero-filled sensor?){what}"
-        )
-    return np.ascontiguousarray(x)
+    return _checked(a, name, n, nonzero)[0]
 
 
 #: Angular rates (rad/s) above this are refused: about 100 times the range of MEMS
@@ -121,8 +137,7 @@ def sensor_inputs(acc, gyr, mag=None):
         ``(acc, gyr, mag_or_dummy, use_mag)``: three float64 arrays and a bool.
     """
     acc = samples(acc, "acc", nonzero=True)
-    gyr = samples(gyr, "gyr", acc.shape[0])
-    peak = float(np.abs(gyr).max())
+    gyr, peak = _checked(gyr, "gyr", acc.shape[0], None)
     if peak > MAX_GYR_RAD_S:
         raise ValueError(
             f"gyr reaches {peak:.3g} rad/s ({np.degrees(peak):.3g} deg/s), beyond any "

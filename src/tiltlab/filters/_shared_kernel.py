@@ -1,4 +1,4 @@
-"""Numba helpers that the filters' kernels share: reading a unit sample."""
+"""Numba helpers that the filters share: reading a unit sample, scanning inputs once."""
 
 from __future__ import annotations
 
@@ -15,3 +15,27 @@ def _unit_sample(a, k):
     if n > 0.0:
         return x / n, y / n, z / n, n
     return x, y, z, n
+
+
+@njit(cache=True, nogil=True)
+def _scan_samples(x):
+    # one pass over an (N, 3) array: NaN count, ±inf count, whether any value is
+    # non-zero, largest absolute finite value
+    n_nan = 0
+    n_inf = 0
+    nonzero = False
+    peak = 0.0
+    for k in range(x.shape[0]):
+        for j in range(x.shape[1]):
+            v = x[k, j]
+            if v != v:
+                n_nan += 1
+            elif v == np.inf or v == -np.inf:
+                n_inf += 1
+            else:
+                if v != 0.0:
+                    nonzero = True
+                a = abs(v)
+                if a > peak:
+                    peak = a
+    return n_nan, n_inf, nonzero, peak
