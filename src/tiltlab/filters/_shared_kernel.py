@@ -13,7 +13,8 @@ def _unit_sample(a, k):
     x, y, z = a[k, 0], a[k, 1], a[k, 2]
     n = np.sqrt(x * x + y * y + z * z)
     if n > 0.0:
-        return x / n, y / n, z / n, n
+        r = 1.0 / n  # one division, three products (the loops are latency-bound)
+        return x * r, y * r, z * r, n
     return x, y, z, n
 
 

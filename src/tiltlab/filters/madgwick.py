@@ -79,13 +79,14 @@ def _madgwick_kernel(acc, gyr, mag, use_mag, dt, beta, q0, out):
                 )
             sn = np.sqrt(s0 * s0 + s1 * s1 + s2 * s2 + s3 * s3)
             if sn > 0.0:
-                dw -= beta * s0 / sn
-                dx -= beta * s1 / sn
-                dy -= beta * s2 / sn
-                dz -= beta * s3 / sn
+                g = beta / sn  # one division for the four components
+                dw -= g * s0
+                dx -= g * s1
+                dy -= g * s2
+                dz -= g * s3
         w, x, y, z = w + dw * dt, x + dx * dt, y + dy * dt, z + dz * dt
-        n = np.sqrt(w * w + x * x + y * y + z * z)
-        w, x, y, z = w / n, x / n, y / n, z / n
+        r = 1.0 / np.sqrt(w * w + x * x + y * y + z * z)
+        w, x, y, z = w * r, x * r, y * r, z * r
         if use_mag:
             out[k, 0], out[k, 1], out[k, 2], out[k, 3] = qmul_scalar(
                 c, 0.0, 0.0, c, w, x, y, z
