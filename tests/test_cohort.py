@@ -552,3 +552,34 @@ def test_session_tilt_is_the_pipelines_tilt():
     np.testing.assert_allclose(
         mu, [float(feats[f"tilt_immobile_{a}"]) for a in "xyz"], atol=1e-9
     )
+
+
+def test_each_session_is_validated_once(sim, serial, tmp_path, monkeypatch):
+    """The reader validates every session; the feature step does not again."""
+    import sys
+
+    import tiltlab.schema as schema
+
+    real = schema.validate
+    callers = []
+
+    def spy(rec, *args, **kw):
+        callers.append(sys._getframe(1).f_code.co_filename)
+        return real(rec, *args, **kw)
+
+    monkeypatch.setattr(schema, "validate", spy)
+    manifest = _subset(cohort.read_manifest(sim / "manifest.csv"), 2)
+    ds = cohort.run_cohort(
+        manifest, scheduler=None, workers=1, cache_dir=tmp_path, progress=False
+    )
+    assert list(ds["status"].values) == ["ok", "ok"]
+    in_features = [f for f in callers if f.endswith("features.py")]
+    assert callers and not in_features
+    # the same features as the full serial run
+    expected = serial[0].isel(session=slice(0, 2))
+    xr.testing.assert_identical(_values(ds), _values(expected))
+    # a Recording handed over directly is still validated
+    rec = cohort.load_session(manifest.table.iloc[0].to_dict(), manifest.root)
+    callers.clear()
+    cohort.session_features(rec)
+    assert any(f.endswith("features.py") for f in callers)

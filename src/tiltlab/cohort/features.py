@@ -350,6 +350,7 @@ def session_features(
     *,
     calibration=None,
     check_units: bool = True,
+    validate: bool = True,
 ) -> xr.Dataset:
     r"""Head-tilt features of one session, as a Dataset of labelled scalars.
 
@@ -366,6 +367,10 @@ def session_features(
     check_units : bool
         Check the values against their unit labels when re-validating the Recording
         (:func:`tiltlab.schema.validate`); ``False`` accepts the labels as they are.
+    validate : bool
+        Validate ``rec`` first (default). ``False`` is for a Recording that its reader
+        has just validated (the cohort pipeline reads every session through one), so
+        that each session is validated once.
 
     Returns
     -------
@@ -417,7 +422,7 @@ def session_features(
     ----------
     .. [1] R. Fayat et al., Sensors 21(18):6318, 2021. doi:10.3390/s21186318
     """
-    config = _checked(rec, config, check_units)
+    config = _checked(rec, config, check_units, validate)
     acc = _Features(feature_specs(config))
     has_gyr = "gyr" in rec
     offset_notes: list[str] = []
@@ -441,7 +446,9 @@ def session_features(
     return _dataset(acc.out, config, attrs, acc.reasons)
 
 
-def _checked(rec, config: FeatureConfig | None, check_units: bool) -> FeatureConfig:
+def _checked(
+    rec, config: FeatureConfig | None, check_units: bool, validate: bool = True
+) -> FeatureConfig:
     """Check both inputs and return the configuration (default ``FeatureConfig()``)."""
     config = config or FeatureConfig()
     if not isinstance(config, FeatureConfig):
@@ -450,7 +457,8 @@ def _checked(rec, config: FeatureConfig | None, check_units: bool) -> FeatureCon
         raise TypeError(
             f"rec must be a Recording (xarray.Dataset), got {type(rec).__name__}"
         )
-    _schema.validate(rec, allow_nan=True, check_units=check_units)
+    if validate:
+        _schema.validate(rec, allow_nan=True, check_units=check_units)
     return config
 
 

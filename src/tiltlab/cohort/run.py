@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import functools
 import hashlib
-import inspect
 import json
 import os
 import sys
@@ -56,9 +55,6 @@ __all__ = [
 #: bump when the feature computation changes in a way the config hash cannot see
 CACHE_VERSION = 1
 DEFAULT_CACHE = ".tiltlab-cache"
-
-#: keywords :func:`session_features` takes (``check_units`` once it re-validates with it)
-_FEATURE_PARAMS = frozenset(inspect.signature(session_features).parameters)
 
 
 # ------------------------------------------------------------------ one session
@@ -123,10 +119,9 @@ def compute_session(row: dict, root: str, config: FeatureConfig) -> dict[str, An
     try:
         rec = load_session(row, root)
         cal = _calibration_of(row, root)
-        kw = {}
-        if not _check_units(row) and "check_units" in _FEATURE_PARAMS:
-            kw["check_units"] = False  # the feature step's re-validation, too
-        ds = session_features(rec, config, calibration=cal, **kw)
+        # load_session validated the Recording with the row's reader options: the
+        # feature step does not validate it a second time
+        ds = session_features(rec, config, calibration=cal, validate=False)
     except Exception as exc:  # any failure is recorded, never propagated
         if isinstance(exc, UnitCheckError):
             exc = exc.for_switch("manifest")
