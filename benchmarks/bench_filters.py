@@ -19,7 +19,7 @@ from tiltlab import evaluate as E
 from tiltlab import filters as F
 from tiltlab import quaternion as Q
 from tiltlab.schema import make_recording
-from _timing import best_of
+from _timing import best_of, print_scaling, scaling
 
 
 def synthetic(n: int, fs: float = 200.0, seed: int = 0):
@@ -188,6 +188,8 @@ def main() -> None:
         f"madgwick_batch (numba prange, 2 threads): {args.grid} gains x {n:,} samples: {t_batch:.2f} s"
     )
 
+    print_native_scaling(acc, gyr, fs, q0, n)
+
     print("\ntargets:")
     mad = dict(rows)["madgwick 6D"]
     ekf = dict(rows)["ekf 6D"]
@@ -201,6 +203,21 @@ def main() -> None:
         f"  30-gain grid over 1 M samples < 5 s: {t_grid:.2f} s (grid_search), {t_batch:.2f} s (batch) -> "
         f"{'OK' if min(t_grid, t_batch) < 5 else 'MISSED'}"
     )
+
+
+def print_native_scaling(acc, gyr, fs, q0, n: int) -> None:
+    """Throughput of the native filters at n/100, n/10 and n samples, with the fitted
+    exponent (flat throughput: time ~ n^1)."""
+    sizes = [max(1000, n // 100), max(10_000, n // 10), n]
+    print(f"\nscaling (samples: {', '.join(f'{s:,}' for s in sizes)}):")
+    for name, fn in (
+        ("madgwick 6D", lambda k: F.madgwick(acc[:k], gyr[:k], fs, beta=0.05, q0=q0)),
+        ("mahony 6D", lambda k: F.mahony(acc[:k], gyr[:k], fs, q0=q0)),
+        ("complementary 6D", lambda k: F.complementary(acc[:k], gyr[:k], fs, q0=q0)),
+        ("ekf 6D", lambda k: F.ekf(acc[:k], gyr[:k], fs, q0=q0)),
+    ):
+        times, b = scaling(fn, sizes)
+        print_scaling(name, sizes, times, b)
 
 
 if __name__ == "__main__":
