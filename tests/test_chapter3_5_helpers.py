@@ -117,19 +117,6 @@ def test_allan_table_bad_inputs():
 
 
 # ------------------------------------------------------------------ learn tables
-def _old_describe(m):
-    if isinstance(m, torch.nn.Conv1d):
-        return (
-            f"{m.in_channels} → {m.out_channels} channels, kernel {m.kernel_size[0]}, "
-            f"dilation {m.dilation[0]}"
-        )
-    if isinstance(m, torch.nn.BatchNorm1d):
-        return f"{m.num_features} channels"
-    if isinstance(m, torch.nn.Linear):
-        return f"{m.in_features} → {m.out_features}"
-    return ""
-
-
 def test_layer_table_of_the_orientation_cnn():
     cfg = L.TrainConfig(channels=8)
     model = L.build_model(cfg, 500.0)
@@ -137,9 +124,25 @@ def test_layer_table_of_the_orientation_cnn():
     leaves = [(n, m) for n, m in model.named_modules() if n and not list(m.children())]
     assert t.index.name == "layer" and list(t.index) == [n for n, _ in leaves]
     assert list(t.columns) == ["type", "settings", "weights"]
-    assert t["settings"].tolist() == [_old_describe(m) for _, m in leaves]
     assert t["weights"].sum() == sum(p.numel() for p in model.parameters())
     assert any(s.startswith("10 → 8 channels") for s in t["settings"])
+
+
+def test_layer_settings_of_known_layers():
+    model = torch.nn.Sequential(
+        torch.nn.Conv1d(10, 8, 3, dilation=2),
+        torch.nn.BatchNorm1d(8),
+        torch.nn.ReLU(),
+        torch.nn.Linear(8, 4),
+    )
+    t = L.layer_table(model)
+    assert t["settings"].tolist() == [
+        "10 → 8 channels, kernel 3, dilation 2",
+        "8 channels",
+        "",
+        "8 → 4",
+    ]
+    assert t["weights"].tolist() == [10 * 8 * 3 + 8, 2 * 8, 0, 8 * 4 + 4]
 
 
 def test_layer_table_of_a_model_without_layers_is_empty():
