@@ -41,8 +41,10 @@ Modules
 :mod:`~tiltlab.evaluate.errors` (error definitions and statistics, BROAD's RMSEs),
 :mod:`~tiltlab.evaluate.selection` (grid search over methods' parameters, LOTO),
 :mod:`~tiltlab.evaluate.recipes` (a grid's best parameters, methods as estimators,
-the tilt difference between two methods, errors pooled over recordings) and
-:mod:`~tiltlab.evaluate.mocap` (the motion-capture reference).
+the tilt difference between two methods, errors pooled over recordings),
+:mod:`~tiltlab.evaluate.mocap` (the motion-capture reference) and
+:mod:`~tiltlab.evaluate.budget` (what bounds an estimate's error: its slow and fast
+parts, and how far estimates can differ).
 """
 
 import warnings as _warnings
@@ -65,10 +67,12 @@ from .errors import (
     tilt_errors,
     tilt_rmse,
 )
+from .budget import error_budget
 from .mocap import mocap_reference
 from .recipes import best_params, estimator, pooled_errors, tilt_difference_rms
 from .selection import error_table, grid_search, loto, loto_summary, optimum
 
+from .budget import __all__ as _budget_all
 from .errors import __all__ as _errors_all
 from .mocap import __all__ as _mocap_all
 from .recipes import __all__ as _recipes_all
@@ -79,6 +83,7 @@ __all__ = [
     *_selection_all,
     *_recipes_all,
     *_mocap_all,
+    *_budget_all,
 ]
 
 
