@@ -34,6 +34,6 @@ def scaling(fn, sizes, repeat: int = 3) -> tuple[list[float], float]:
 def print_scaling(name: str, sizes, times, exponent: float) -> None:
     """Print one line: throughput at each size and the fitted exponent."""
     rates = ", ".join(
-        f"{n:,}: {n / t / 1e6:.2f} M/s" for n, t in zip(sizes, times, strict=True)
+        f"{n:,}: {n / t / 1e6:.3g} M/s" for n, t in zip(sizes, times, strict=True)
     )
     print(f"{name:18s} {rates}; time ~ n^{exponent:.2f}")

@@ -15,7 +15,14 @@ Then Mahony's integral gain ``ki`` is swept on the same data, the parameter that
 no-reference recordings single out. The criterion for a default is that it is never far
 from the other methods on any of these data sets, not that it is best on one of them.
 
-Run: ``python benchmarks/bench_defaults.py [--n-sim 3]`` (about 20 s on 2 cores). Needs the
+Last, a scaling section: each of these methods with its defaults on one simulated rat
+session cut to 12 s, 2 min and 20 min at 300 Hz (×1, ×10, ×100: 3,600 to 360,000
+samples; ``--scaling-max`` sets the largest duration), best of 3 calls (1 for
+``rts_smoother``, the slowest), one line per method with its throughput at each size
+and the fitted exponent of time ~ n^b (1: linear).
+
+Run: ``python benchmarks/bench_defaults.py [--n-sim 3]`` (about 20 s on 2 cores, plus
+about 30 s of scaling). Needs the
 BROAD trials and the Fayat example (``TILTLAB_DATA_DIR``); the foreign recordings are
 read from ``$TILTLAB_DATA_DIR/foreign`` and skipped with a note when absent.
 """
@@ -35,6 +42,8 @@ from tiltlab import calibration, datasets, simulate
 from tiltlab import evaluate as E
 from tiltlab import filters as F
 from tiltlab.schema import make_recording
+
+from _scaling_extra import RTS_STEP, note_far, scaling_section
 
 #: methods with tunable registry defaults (the slow pure-Python ``ahrs`` adapters are
 #: left out: they mirror that package's own defaults)
@@ -196,10 +205,42 @@ def fmt_params(p: dict) -> str:
     )
 
 
+def print_default_scaling(longest_s: float, fs: float = 300.0) -> None:
+    """Scaling of each method with its defaults on one simulated session cut to
+    ``longest_s`` / 100, / 10 and whole (at ``fs``)."""
+    n = int(longest_s * fs)
+    sizes = [n // 100, n // 10, n]
+    rec = simulate.simulate_session(n / fs, fs, seed=[2021, 99])
+    recs = {k: rec.isel(time=slice(0, k)) for k in sizes}
+    cases = [
+        (m, lambda k, m=m: run(recs[k], m), 1 if m == REFERENCE else 3)
+        for m in TUNED + OTHERS
+    ]
+    exps = scaling_section(
+        f"registry defaults, 6D, simulated session at {fs:g} Hz "
+        f"({', '.join(f'{k / fs:g} s' for k in sizes)})",
+        sizes,
+        cases,
+    )
+    note_far(
+        exps,
+        f"per-call costs that do not grow with n weigh at {sizes[0]:,} samples "
+        "(validating the Recording, the initial orientation from the first "
+        "init_window_s, building the output DataArray)",
+        high_known={"rts_smoother": RTS_STEP},
+    )
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--n-sim", type=int, default=3)
     ap.add_argument("--sim-duration", type=float, default=120.0)
+    ap.add_argument(
+        "--scaling-max",
+        type=float,
+        default=1200.0,
+        help="longest recording of the scaling section (s); also /10 and /100",
+    )
     args = ap.parse_args()
     t_start = time.perf_counter()
     print(
@@ -282,7 +323,12 @@ def main() -> None:
             a, b = score_offline(rec, refs[name], "mahony", ki=ki)
             cells.append(f"{f'{a:.2f}/{b:.1f}':>{width}}")
         print(f"{ki:<14g}" + "".join(cells))
-    print(f"\ntotal {time.perf_counter() - t_start:.0f} s")
+    t_scaling = time.perf_counter()
+    print_default_scaling(args.scaling_max)
+    print(
+        f"\ntotal {time.perf_counter() - t_start:.0f} s "
+        f"(scaling {time.perf_counter() - t_scaling:.0f} s)"
+    )
 
 
 if __name__ == "__main__":

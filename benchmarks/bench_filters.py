@@ -7,7 +7,7 @@ over 1 M samples < 5 s on 2 cores; the chosen offline smoother (``filters.smooth
 section prints each filter's throughput at n/100, n/10 and n samples with the fitted
 exponent of time ~ n^b (b = 1: flat throughput).
 
-Run: ``python benchmarks/bench_filters.py [--n 1080000] [--n-ref 20000]``.
+Run: ``python benchmarks/bench_filters.py [--n 1080000] [--n-ref 20000] [--scaling-max 10000000]``.
 """
 
 from __future__ import annotations
@@ -61,6 +61,13 @@ def main() -> None:
         type=int,
         default=100_000,
         help="samples for the (slow) error-state RTS smoother",
+    )
+    ap.add_argument(
+        "--scaling-max",
+        type=int,
+        default=0,
+        help="also print the native filters' scaling up to this many samples "
+        "(e.g. 10000000: 100 k, 1 M and 10 M; about 1 GB of memory)",
     )
     args = ap.parse_args()
     n, n_ref = args.n, args.n_ref
@@ -209,6 +216,10 @@ def main() -> None:
     )
 
     print_native_scaling(acc, gyr, fs, q0, n)
+    if args.scaling_max > n:
+        acc_l, gyr_l, _, q_l, _ = synthetic(args.scaling_max)
+        print_native_scaling(acc_l, gyr_l, fs, q_l[0], args.scaling_max)
+        del acc_l, gyr_l, q_l
     print_offline_scaling(acc, gyr, fs, n, no)
     mad_ratio = print_duration_ratios(acc, gyr, mag, fs, q0, a_r, g_r, m_r)
 
@@ -235,8 +246,10 @@ def main() -> None:
 
 
 def print_native_scaling(acc, gyr, fs, q0, n: int) -> None:
-    """Throughput of the native filters at n/100, n/10 and n samples, with the fitted
-    exponent (flat throughput: time ~ n^1)."""
+    """Print the native filters' throughput at n/100, n/10 and n samples.
+
+    Each line ends with the fitted exponent (flat throughput: time ~ n^1).
+    """
     sizes = [max(1000, n // 100), max(10_000, n // 10), n]
     print(f"\nscaling (samples: {', '.join(f'{s:,}' for s in sizes)}):")
     for name, fn in (
@@ -244,6 +257,7 @@ def print_native_scaling(acc, gyr, fs, q0, n: int) -> None:
         ("mahony 6D", lambda k: F.mahony(acc[:k], gyr[:k], fs, q0=q0)),
         ("complementary 6D", lambda k: F.complementary(acc[:k], gyr[:k], fs, q0=q0)),
         ("ekf 6D", lambda k: F.ekf(acc[:k], gyr[:k], fs, q0=q0)),
+        ("eskf 6D", lambda k: F.eskf(acc[:k], gyr[:k], fs, q0=q0)),
     ):
         times, b = scaling(fn, sizes)
         print_scaling(name, sizes, times, b)

@@ -17,6 +17,13 @@ trial's first samples; samples/s; ratio = how many times slower than Mahony 9D):
   The end to end cost of a CNN is its input row plus its loop row (printed below the
   table).
 
+Scaling section: Mahony 9D, RIANN 6D, the CNN input and both CNN loops (with the first
+of ``--threads``) on the trial's first N/100, N/10 and N samples (×1, ×10, ×100; best
+of ``--repeat`` calls each), one line per method with its throughput at each size and
+the fitted exponent of time ~ n^b (1: linear). Per-call costs that do not grow with n
+(Mahony's input checks, the CNN input's reading of the Recording, RIANN's ONNX session
+created at each call) pull the exponent below 1 where they weigh at the smallest size.
+
 The weights do not change the speed: ``data/learn/<variant>_fold0.pt`` is used when it
 exists, else ``/tmp/quick/<variant>_fold0.pt``, else a model trained for 5 steps (the
 script prints which). The figures are wall times: run it on an otherwise idle machine.
@@ -41,6 +48,7 @@ import torch
 import tiltlab
 import tiltlab.learn as L
 from tiltlab import filters as F
+from _scaling_extra import ladder, note_far, scaling_section
 from _timing import best_of
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -83,6 +91,56 @@ def model_for(variant: str, rec):
     model, _ = L.train([seq], cfg, max_steps=5)
     torch.use_deterministic_algorithms(False)  # set by train; load() leaves it off
     return model, cfg, "untrained (5 steps on this trial; no model file found)"
+
+
+def print_learn_scaling(rec, inputs, models, threads: int, repeat: int) -> None:
+    """Scaling of Mahony, RIANN, the CNN input and the CNN loops on the trial's first
+    N/100, N/10 and N samples."""
+    n = rec.sizes["time"]
+    sizes = ladder(n)
+    torch.set_num_threads(threads)
+    x9 = {k: head(inputs[True], k) for k in sizes}
+    x6 = {k: head(inputs[False], k) for k in sizes}
+    recs = {k: rec.isel(time=slice(0, k)) for k in sizes}
+    cases = [
+        ("Mahony 9D", lambda k: F.run_method("mahony", x9[k])),
+        ("RIANN 6D", lambda k: F.run_method("riann", x6[k])),
+    ]
+    seqs = {}
+    for variant, (model, cfg) in models.items():
+        key = (cfg.acc_scale, cfg.mag_scale)
+        if key not in seqs:
+            cases.append(
+                (
+                    "CNN input" + (f" {len(seqs) + 1}" if seqs else ""),
+                    lambda k, a=key[0], m=key[1]: L.sequence(
+                        recs[k], acc_scale=a, mag_scale=m
+                    ),
+                )
+            )
+            seq = L.sequence(rec, acc_scale=key[0], mag_scale=key[1])
+            seqs[key] = {k: head(seq, k) for k in sizes}
+        cases.append(
+            (
+                VARIANTS[variant].replace("learned ", ""),
+                lambda k, mo=model, c=cfg, s=seqs[key]: L.closed_loop_estimate(
+                    mo, s[k], c
+                ),
+            )
+        )
+    exps = scaling_section(
+        f"BROAD trial, torch threads {threads}, best of {repeat}",
+        sizes,
+        cases,
+        repeat,
+    )
+    note_far(
+        exps,
+        f"per-call costs that do not grow with n weigh at {sizes[0]:,} samples "
+        "(Mahony: input checks and the call, a fraction of a millisecond; CNN input: "
+        "reading the Recording through xarray; RIANN: an ONNX session created at "
+        "each call)",
+    )
 
 
 def main() -> None:
@@ -166,6 +224,7 @@ def main() -> None:
                 f"  {label:20s} {threads} thread(s): {tt:.3f} s, {n / tt:,.0f} samples/s, "
                 f"{tt / t_mahony:.1f}x Mahony"
             )
+    print_learn_scaling(rec, inputs, models, args.threads[0], repeat)
     load2 = os.getloadavg()[0]
     if max(load1, load2) > 0.5:
         print(

@@ -33,6 +33,14 @@ extrapolated rows the note also gives ``+GB`` scaled linearly to the whole recor
 fails (an exception, a crash, a time-out, not started) is reported in the table, and
 the exit status is then 1.
 
+Scaling section (after the table): each method that ran, on the first N/100, N/10 and
+N samples of the N it ran on (×1, ×10, ×100), all in one more fresh subprocess (memory
+is not measured there): best of 3 calls where the table predicts at most 2 s per call,
+else one call; at N, where the table's call took more than 10 s, that call is used
+(marked ``*``) instead of a rerun. One line per method with its throughput at each
+size and the fitted exponent of time ~ n^b (1: linear). It adds about a tenth of the
+table's time, plus a few seconds per method.
+
 The figures are wall times on a shared machine: other programs' CPU load slows them.
 
 Run: ``python benchmarks/bench_scale.py [--quick] [--hours 6] [--json out.json]``
@@ -273,9 +281,129 @@ def run_probed(
     return r
 
 
+def child_scaling(data: Path, spec: list[dict]) -> list[dict]:
+    """For each ``{"method", "use_mag", "sizes", "repeats"}`` of ``spec``: warm up, then
+    time ``estimate`` on the first ``sizes`` samples, best of ``repeats`` calls (after
+    one untimed call when more than one; 0: not timed, None returned); a method's
+    exception is reported in its entry."""
+    from tiltlab import filters as F
+    from tiltlab.schema import make_recording
+
+    from _timing import best_of
+
+    n = max(max(e["sizes"]) for e in spec)
+    arrays = {
+        k: np.load(data / f"{k}.npy", mmap_mode="r") for k in ("acc", "gyr", "mag")
+    }
+    acc, gyr, mag = (np.array(arrays[k][:n]) for k in ("acc", "gyr", "mag"))
+    del arrays
+
+    def estimate(e: dict, k: int):
+        rec = make_recording(
+            acc[:k],
+            gyr[:k],
+            FS,
+            acc_units="m/s^2",
+            gyr_units="rad/s",
+            mag=mag[:k] if e["use_mag"] else None,
+            mag_units="uT",
+        )
+        return lambda: F.estimate(rec, e["method"], use_mag=e["use_mag"])
+
+    out = []
+    for e in spec:
+        try:
+            estimate(e, min(WARMUP, n))()
+            times = [
+                best_of(estimate(e, k), r, warmup=r > 1) if r else None
+                for k, r in zip(e["sizes"], e["repeats"], strict=True)
+            ]
+            out.append({"seconds": times})
+        except Exception as exc:  # reported by the parent, not hidden
+            out.append({"error": f"{type(exc).__name__}: {exc}"})
+    return out
+
+
+def _repeats(row: dict, sizes: list[int]) -> list[int]:
+    """Calls per size for the scaling section, from the table's time at N: 3 where a
+    call is predicted to take at most 2 s, else 1; at N itself, 0 (the table's call is
+    used) where it took more than 10 s."""
+    per_sample = row["seconds"] / row["n_run"]
+    reps = [3 if k * per_sample <= 2.0 else 1 for k in sizes]
+    if row["seconds"] > 10.0:
+        reps[-1] = 0
+    return reps
+
+
+def print_scale_scaling(rows: list[dict], data: Path, timeout: float) -> list[str]:
+    """Time each successful row's method at N/100, N/10 and N (its measured N) in one
+    fresh subprocess, print one scaling line per row and store it in the row; returns
+    the failures."""
+    from _scaling_extra import RTS_STEP, fit_exponent, note_far, print_line
+
+    ok = [r for r in rows if "error" not in r]
+    spec = []
+    for r in ok:
+        sizes = [r["n_run"] // 100, r["n_run"] // 10, r["n_run"]]
+        spec.append(
+            {
+                "method": r["method"],
+                "use_mag": r["dims"] != "6D",
+                "sizes": sizes,
+                "repeats": _repeats(r, sizes),
+            }
+        )
+    if not spec:
+        return []
+    (data / "scaling_spec.json").write_text(json.dumps(spec))
+    t0 = time.perf_counter()
+    res = run_one("scaling", data, 0, False, timeout, data)
+    wall = time.perf_counter() - t0
+    if "error" in res:
+        print(f"\nscaling: FAILED: {res['error']}")
+        return ["scaling section"]
+    print(
+        "\nscaling (each method on N/100, N/10 and N samples, N as in the table; best "
+        "of 3 calls where a call takes at most 2 s, else 1; * = N point from the "
+        "table, not rerun):"
+    )
+    failed, exps = [], {}
+    for r, e, got in zip(ok, spec, res["scaling"], strict=True):
+        label = f"{r['method']} {r['dims']}"
+        if "error" in got:
+            print(f"{label:18s} FAILED: {got['error']}")
+            failed.append(f"{label} (scaling)")
+            continue
+        times = got["seconds"]
+        if times[-1] is None:
+            times[-1] = r["seconds"]
+            label += " *"
+        b = fit_exponent(e["sizes"], times)
+        print_line(label, e["sizes"], times, b)
+        r["scaling"] = {"sizes": e["sizes"], "seconds": times, "exponent": b}
+        exps[label] = b
+    note_far(
+        exps,
+        "per-call costs that do not grow with n (validating the Recording, the "
+        "initial orientation, building the output DataArray) weigh at N/100",
+        high_known={"rts_smoother": RTS_STEP},
+    )
+    if any(k.endswith("*") for k in exps):
+        print(
+            "note: * rows fit reruns and the table's call, made at different times: "
+            "a change of the machine's load between them moves their exponent"
+        )
+    print(f"(scaling section: {wall:.0f} s)")
+    return failed
+
+
 def _child_main(args) -> None:
     try:
-        res = child(args.child, Path(args.data), args.n, args.use_mag)
+        if args.child == "scaling":
+            spec = json.loads((Path(args.data) / "scaling_spec.json").read_text())
+            res = {"scaling": child_scaling(Path(args.data), spec), "seconds": 0.0}
+        else:
+            res = child(args.child, Path(args.data), args.n, args.use_mag)
     except Exception as exc:  # reported by the parent, not hidden
         res = {"error": f"{type(exc).__name__}: {exc}"}
     Path(args.out).write_text(json.dumps(res))
@@ -400,14 +528,15 @@ def main() -> None:
                         flush=True,
                     )
                 rows.append(row)
-    rts = [r for r in rows if r["method"] == "rts_smoother" and "error" not in r]
-    if rts:
-        r = rts[0]
-        print(
-            f"\nrts_smoother on {label}: peak {r['peak_gb']:.2f} GB "
-            f"(+{r['added_gb']:.2f} GB over the loaded Recording), "
-            f"{r['seconds_total']:.0f} s"
-        )
+        rts = [r for r in rows if r["method"] == "rts_smoother" and "error" not in r]
+        if rts:
+            r = rts[0]
+            print(
+                f"\nrts_smoother on {label}: peak {r['peak_gb']:.2f} GB "
+                f"(+{r['added_gb']:.2f} GB over the loaded Recording), "
+                f"{r['seconds_total']:.0f} s"
+            )
+        failed += print_scale_scaling(rows, tmp, args.timeout)
     if args.json:
         Path(args.json).write_text(
             json.dumps(

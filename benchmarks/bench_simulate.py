@@ -4,6 +4,13 @@ Targets (issue 3): one hour of 300 Hz 6-axis data in < 2 s on one core, and the
 paper-size cohort (58 animals × 7 sessions × 20 min at 100 Hz ≈ 49 M samples) in
 < 3 min on 2 cores.
 
+Then a scaling section: head kinematics, the sensor model (``recording_from_motion`` on
+that motion) and ``simulate_session`` end to end, at 36 s, 6 min and 1 h of 300 Hz
+(×1, ×10, ×100: 10,800 to 1,080,000 samples), best of 3 each; one line per operation
+with its throughput at each size and the fitted exponent of time ~ n^b (1: linear).
+The cohort is not scaled (its smallest useful run is already minutes): its
+per-session cost is what the subset measures.
+
 Usage::
 
     python benchmarks/bench_simulate.py            # 1 h single session + a 35-session cohort subset, extrapolated
@@ -28,6 +35,8 @@ from tiltlab.simulate import (
     simulate_cohort,
     simulate_session,
 )
+
+from _scaling_extra import note_far, scaling_section
 
 PAPER_SAMPLES = 58 * 7 * 1200 * 100
 
@@ -57,6 +66,31 @@ def bench_session(repeats: int = 3) -> None:
     )
     print(
         f"  target < 2 s: {'PASS' if best < 2.0 else 'FAIL'} (ratio to target {best / 2.0:.2f})"
+    )
+
+
+def bench_session_scaling(fs: float = 300.0) -> None:
+    """Scaling of one session's simulation at 36 s, 6 min and 1 h of ``fs`` Hz."""
+    sizes = [int(d * fs) for d in (36.0, 360.0, 3600.0)]
+    motions = {k: head_kinematics(k / fs, fs, seed=0) for k in sizes}
+    cases = [
+        ("head kinematics", lambda k: head_kinematics(k / fs, fs, seed=0)),
+        (
+            "sensor model",
+            lambda k: recording_from_motion(
+                motions[k], rng=np.random.default_rng(0), keep_true=False
+            ),
+        ),
+        (
+            "simulate_session",
+            lambda k: simulate_session(k / fs, fs, seed=0, keep_true=False),
+        ),
+    ]
+    exps = scaling_section(f"one session at {fs:g} Hz", sizes, cases)
+    note_far(
+        exps,
+        "fixed per-session costs (drawing the behaviour and the sensor, building and "
+        "validating the Recording) still weigh at 36 s",
     )
 
 
@@ -114,6 +148,7 @@ def main() -> None:
     args = ap.parse_args()
 
     bench_session()
+    bench_session_scaling()
     print()
     # default: one animal per group (35 sessions) at the paper's session length; the
     # per-session cost is then representative and extrapolates to the 406 sessions
