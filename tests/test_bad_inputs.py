@@ -1945,6 +1945,12 @@ case(
     r"order.*0",
 )
 case(
+    "dsp-lowpass-order-huge",
+    lambda t: dsp.lowpass(ACC, FS, 2.0, order=1e300),
+    ValueError,
+    r"order must be at most",
+)
+case(
     "dsp-lowpass-cutoff-nan",
     lambda t: dsp.lowpass(ACC, FS, NAN),
     ValueError,

@@ -128,8 +128,10 @@ def nonnegative(value, name: str) -> float:
     return positive(value, name, allow_zero=True)
 
 
-def integer(value, name: str, *, minimum: int | None = None) -> int:
-    """Return ``value`` as an int (integral floats accepted), at least ``minimum``.
+def integer(
+    value, name: str, *, minimum: int | None = None, maximum: int | None = None
+) -> int:
+    """Return ``value`` as an int (integral floats accepted), within the given bounds.
 
     Parameters
     ----------
@@ -139,6 +141,8 @@ def integer(value, name: str, *, minimum: int | None = None) -> int:
         Named in the error.
     minimum : int, optional
         Smallest accepted value.
+    maximum : int, optional
+        Largest accepted value.
 
     Returns
     -------
@@ -150,6 +154,8 @@ def integer(value, name: str, *, minimum: int | None = None) -> int:
         raise ValueError(f"{name} must be an integer, got {value!r}")
     if minimum is not None and v < minimum:
         raise ValueError(f"{name} must be at least {minimum}, got {value!r}")
+    if maximum is not None and v > maximum:
+        raise ValueError(f"{name} must be at most {maximum}, got {value!r}")
     return int(v)
 
 

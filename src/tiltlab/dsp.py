@@ -59,6 +59,11 @@ def window_samples(
     return max(int(round(window_s * fs)), minimum)
 
 
+#: the largest Butterworth order accepted per pass (higher orders only add ringing and
+#: rounding: the zero-phase filter already has twice the order)
+MAX_ORDER = 32
+
+
 def lowpass(
     x, fs: float, cutoff_hz: float, *, order: int = 2, name: str = "x"
 ) -> np.ndarray:
@@ -73,7 +78,8 @@ def lowpass(
     cutoff_hz : float
         Cut-off frequency (Hz), ``0 < cutoff_hz < fs/2``.
     order : int
-        Butterworth order of each pass (the forward–backward filter has order ``2·order``).
+        Butterworth order of each pass, 1 to :data:`MAX_ORDER` (the forward–backward
+        filter has order ``2·order``).
     name : str
         Name of ``x`` in error messages.
 
@@ -92,7 +98,7 @@ def lowpass(
     """
     fs = _v.check_fs(fs)
     cutoff_hz = _v.positive(cutoff_hz, "cutoff_hz")
-    order = _v.integer(order, "order", minimum=1)
+    order = _v.integer(order, "order", minimum=1, maximum=MAX_ORDER)
     if cutoff_hz >= fs / 2:
         raise ValueError(
             f"cutoff_hz must be below the Nyquist frequency {fs / 2:g} Hz, got {cutoff_hz:g}"
