@@ -281,8 +281,8 @@ def _scatter(x, w, h, grid: EqualAreaGrid, settings: _KDESettings) -> np.ndarray
         1,
         min(numba.get_num_threads(), x.shape[0], 4 * _MAX_CELLS // (per * ncell)),
     )
-    out = np.zeros((nchunk, grid.n_lat, grid.n_lon))
-    scratch = np.empty((nchunk, ncell) if quadrature == "mass" else (1, 1))
+    out = np.zeros((nchunk, ncell))
+    scratch = np.empty((nchunk, ncell) if quadrature == "mass" else (nchunk, 1))
     _kde_scatter(
         np.ascontiguousarray(lon),
         np.ascontiguousarray(s),
@@ -296,7 +296,7 @@ def _scatter(x, w, h, grid: EqualAreaGrid, settings: _KDESettings) -> np.ndarray
         out,
         scratch,
     )
-    return out.sum(axis=0) / w.sum()
+    return out.sum(axis=0).reshape(grid.n_lat, grid.n_lon) / w.sum()
 
 
 def _settings_grid(settings: _KDESettings, vectors, weights=None) -> EqualAreaGrid:

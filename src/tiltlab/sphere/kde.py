@@ -39,6 +39,9 @@ ring of cells. What no grid quadrature gives is the shape of a kernel inside a c
 a kernel narrower than the cells around it the density is not the cell average (its
 mass goes to the nearest cell centres, which may lie one cell off where the cells are
 tall); :func:`grid_for` (data on the grid's equator) or a finer grid avoids that.
+The mass quadrature computes exp with a vectorised routine (within 2 ulp) and sums
+each kernel's values in vectorised order: its density is the kernel sum above to
+rounding (relative ~1e-15), not bit for bit that of a scalar loop.
 
 Grid
 ----
