@@ -42,7 +42,9 @@ import logging
 import os
 import shutil
 import tempfile
+import threading
 import time
+import warnings
 from collections import defaultdict
 from pathlib import Path
 
@@ -51,6 +53,10 @@ import numpy as np
 from tiltlab import behavior, cohort, filters, io, schema, simulate, sphere, units
 from tiltlab.cohort import features as _features
 from tiltlab.cohort import run as _run
+from tiltlab.cohort.schedulers import backend
+from tiltlab.quality import QualityWarning
+
+from _timing import print_scaling
 
 PAPER_SESSIONS = 58 * 7
 PAPER_SAMPLES = PAPER_SESSIONS * 1200 * 300
@@ -87,14 +93,19 @@ class CpuMeter:
     Linux only (``/proc``); elsewhere both are NaN. The tree's CPU counts live
     descendants and, through ``cutime``/``cstime``, those already reaped (dask workers
     and pool processes). ``other`` is the machine's busy time minus the tree's: CPU taken
-    by other programs, which inflates every wall time measured meanwhile.
+    by other programs, which inflates every wall time measured meanwhile. ``main`` is
+    this process's own CPU time and ``workers`` the CPU seconds of each descendant that
+    used more than 0.5 s (pool or dask workers), sampled every 0.2 s by a thread while
+    they live.
     """
 
     def __init__(self):
         self.tick = os.sysconf("SC_CLK_TCK") if hasattr(os, "sysconf") else 100
-        self.own = self.other = float("nan")
+        self.own = self.other = self.main = float("nan")
+        self.workers: dict[int, float] = {}
+        self._stop = threading.Event()
 
-    def _tree(self) -> float:
+    def _scan(self) -> tuple[set[int], dict[int, list[str]]]:
         me, parent, fields = os.getpid(), {}, {}
         for name in os.listdir("/proc"):
             if name.isdigit():
@@ -106,7 +117,25 @@ class CpuMeter:
             new = {p for p, pp in parent.items() if pp in tree and p not in tree}
             tree |= new
             grew = bool(new)
+        return tree, fields
+
+    def _tree(self) -> float:
+        tree, fields = self._scan()
         return sum(sum(int(x) for x in fields[p][11:15]) for p in tree if p in fields)
+
+    def _sample(self) -> None:
+        me = os.getpid()
+        while not self._stop.wait(0.2):
+            try:
+                tree, fields = self._scan()
+            except OSError:
+                continue
+            for p in tree - {me}:
+                if p in fields:
+                    cpu = (int(fields[p][11]) + int(fields[p][12])) / self.tick
+                    if p not in self._start:
+                        self._start[p] = 0.0 if p not in self._before else cpu
+                    self._last[p] = cpu
 
     @staticmethod
     def _busy() -> float:
@@ -117,16 +146,28 @@ class CpuMeter:
     def __enter__(self) -> "CpuMeter":
         try:
             self._t0, self._b0 = self._tree(), self._busy()
+            self._before = self._scan()[0]
         except OSError:
             self._t0 = None
+            return self
+        self._m0 = sum(os.times()[:2])
+        self._start: dict[int, float] = {}
+        self._last: dict[int, float] = {}
+        self._thread = threading.Thread(target=self._sample, daemon=True)
+        self._thread.start()
         return self
 
     def __exit__(self, *exc) -> None:
         if self._t0 is None:
             return
+        self._stop.set()
+        self._thread.join()
         own = self._tree() - self._t0
         self.own = own / self.tick
         self.other = max(self._busy() - self._b0 - own, 0) / self.tick
+        self.main = sum(os.times()[:2]) - self._m0
+        used = {p: self._last[p] - self._start[p] for p in self._last}
+        self.workers = {p: c for p, c in used.items() if c > 0.5}
 
 
 # --------------------------------------------------------------------------- data
@@ -335,26 +376,43 @@ def run(manifest, config, cache: Path, **kwargs) -> tuple[float, CpuMeter, objec
     return wall, cpu, ds
 
 
-def cluster_startup(workers: int) -> float:
-    """Wall time to start and close a local dask cluster of ``workers`` processes."""
-    from distributed import Client, LocalCluster
+def startup(scheduler: str, workers: int) -> tuple[float, list]:
+    """Wall time to start ``workers`` workers of a back end, give each a task, close it.
+
+    Returns the time and, from the workers, their ``MALLOC_TRIM_THRESHOLD_`` and numba
+    thread count (what ``run_cohort``'s tasks see there).
+    """
+    import numba
 
     t0 = time.perf_counter()
-    cluster = LocalCluster(
-        n_workers=workers,
-        threads_per_worker=1,
-        processes=True,
-        dashboard_address=None,
-    )
-    client = Client(cluster)
-    client.close()
-    cluster.close()
-    return time.perf_counter() - t0
+    b = backend(scheduler, workers)
+    try:
+        futs = [b.submit(time.sleep, 0.3) for _ in range(workers)]
+        for f in futs:
+            f.result()
+        info = [
+            b.submit(os.getenv, "MALLOC_TRIM_THRESHOLD_").result(),
+            b.submit(numba.get_num_threads).result(),
+        ]
+    finally:
+        b.close()
+    return time.perf_counter() - t0 - 0.3, info
 
 
 def same_features(a, b) -> bool:
     names = [v for v in a.data_vars if a[v].dtype.kind == "f"]
     return all(np.array_equal(a[v].values, b[v].values, equal_nan=True) for v in names)
+
+
+def _row(name, wall, cpu, t_serial, cores, samples, n) -> str:
+    per = sorted(cpu.workers.values(), reverse=True)
+    in_workers = sum(per) if per else cpu.main
+    shown = " + ".join(f"{c:.1f}" for c in per) if per else f"{cpu.main:.1f} (main)"
+    return (
+        f"   {name:<24}{wall:8.2f}{samples / wall / 1e6:9.2f}{t_serial / wall:9.2f}"
+        f"{cpu.own:8.1f}{cpu.own / (wall * cores):7.0%}{in_workers / n:10.3f}"
+        f"{cpu.other:8.1f}   {shown}"
+    )
 
 
 def bench_end_to_end(manifest, config, tmp: Path, workers: int, samples: int) -> dict:
@@ -367,59 +425,176 @@ def bench_end_to_end(manifest, config, tmp: Path, workers: int, samples: int) ->
         manifest, config, tmp / "cache_serial", scheduler=None
     )
     with CpuMeter() as cpu_start:
-        t_start = cluster_startup(workers)
+        t_start, info_dask = startup("dask", workers)
+        t_pstart, info_proc = startup("processes", workers)
     t_dask, cpu_dask, ds_dask = run(
         manifest, config, tmp / "cache_dask", scheduler="dask", workers=workers
     )
     t_proc, cpu_proc, ds_proc = run(
         manifest, config, tmp / "cache_proc", scheduler="processes", workers=workers
     )
-    ideal = t_serial / workers
     print(
-        f"   {'scheduler':<30}{'wall s':>8}{'M samples/s':>13}{'speed-up':>10}"
-        f"{'CPU s':>8}{'other CPU s':>13}"
+        f"   {'scheduler':<24}{'wall s':>8}{'M/s':>9}{'speed-up':>9}{'CPU s':>8}"
+        f"{'util':>7}{'CPU s/ses':>10}{'other':>8}   CPU s per worker process"
     )
-    for name, wall, cpu in (
-        ("serial (scheduler=None)", t_serial, cpu_serial),
-        (f"dask, {workers} workers", t_dask, cpu_dask),
-        (f"processes, {workers} workers", t_proc, cpu_proc),
-    ):
-        print(
-            f"   {name:<30}{wall:8.2f}{samples / wall / 1e6:13.2f}{t_serial / wall:10.2f}"
-            f"{cpu.own:8.1f}{cpu.other:13.1f}"
+    print(_row("serial", t_serial, cpu_serial, t_serial, 1, samples, n))
+    print(
+        _row(
+            f"dask, {workers} workers", t_dask, cpu_dask, t_serial, workers, samples, n
         )
-    print(
-        f"   dask overhead against serial / {workers} (perfect scaling, {ideal:.2f} s): "
-        f"{t_dask - ideal:+.2f} s ({(t_dask - ideal) / ideal:+.0%}); starting and "
-        f"closing the cluster alone takes {t_start:.2f} s; dask used "
-        f"{cpu_dask.own - cpu_serial.own:+.1f} CPU s more than serial"
     )
     print(
-        f"   dask against a local process pool of the same size: {t_dask - t_proc:+.2f} s "
-        f"(the scheduler's own cost; the rest of the gap to perfect scaling is the "
-        f"machine's and the worker start-up's)"
+        _row(
+            f"processes, {workers} workers",
+            t_proc,
+            cpu_proc,
+            t_serial,
+            workers,
+            samples,
+            n,
+        )
     )
+    print(
+        "   (util: CPU s of the run's processes / (wall × cores it may use); CPU s/ses: "
+        "CPU s in the workers (serial: this process) per session; other: CPU s taken by "
+        "other programs meanwhile)"
+    )
+    print(
+        f"   start-up (start the workers, one task each, close): dask {t_start:.2f} s, "
+        f"processes {t_pstart:.2f} s; the workers see MALLOC_TRIM_THRESHOLD_="
+        f"{info_dask[0]} (dask) / {info_proc[0]} (processes), numba threads "
+        f"{info_dask[1]} / {info_proc[1]}"
+    )
+    for name, wall, t0 in (("dask", t_dask, t_start), ("processes", t_proc, t_pstart)):
+        print(
+            f"   {name}: speed-up {t_serial / wall:.2f} end to end, "
+            f"{t_serial / max(wall - t0, 1e-9):.2f} without its start-up "
+            f"(perfect: {workers})"
+        )
     print(
         f"   identical features: dask {same_features(ds_serial, ds_dask)}, "
         f"processes {same_features(ds_serial, ds_proc)}"
     )
     other = cpu_serial.other + cpu_start.other + cpu_dask.other + cpu_proc.other
-    busy = t_serial + t_start + t_dask + t_proc
+    busy = t_serial + t_start + t_pstart + t_dask + t_proc
     if other > max(2.0, 0.05 * workers * busy):
         print(
             f"   WARNING: other programs used {other:.0f} CPU s of the {workers * busy:.0f} "
-            "available during these runs: the wall times above are inflated; rerun on "
-            "an idle machine"
+            "available during these runs: the wall times above are inflated; judge by "
+            "the CPU s per session, or rerun on an idle machine"
         )
     return {
         "serial": t_serial,
         "dask": t_dask,
         "processes": t_proc,
         "startup": t_start,
+        "pstartup": t_pstart,
         "cpu_dask": cpu_dask.own,
         "cpu_serial": cpu_serial.own,
+        "ses_dask": sum(cpu_dask.workers.values()) / n,
+        "ses_processes": sum(cpu_proc.workers.values()) / n,
         "other": other,
     }
+
+
+# --------------------------------------------------------------------------- scaling
+
+
+def cropped(manifest: cohort.Manifest, tmp: Path, seconds: float, n: int):
+    """``n`` sessions cycling the manifest's files, cut to their first ``seconds``."""
+    import pandas as pd
+
+    table = manifest.table
+    folder = tmp / f"crop_{seconds:g}s"
+    folder.mkdir(parents=True, exist_ok=True)
+    files, cals = [], []
+    for _, row in table.iterrows():
+        dst = folder / Path(row["file"]).name
+        if not dst.exists():
+            rec = io.load_netcdf(cohort.session_path(row["file"], manifest.root))
+            io.save_netcdf(rec.isel(time=slice(0, int(round(seconds * 300)))), dst)
+        files.append(str(dst))
+        cals.append(str(cohort.session_path(row["calibration"], manifest.root)))
+    base = table.assign(file=files, calibration=cals)
+    reps = [
+        base.assign(session=base["session"] + f"_{k}")
+        for k in range(-(-n // len(base)))
+    ]
+    rows = pd.concat(reps).head(n).reset_index(drop=True)
+    return cohort.Manifest(table=rows, root=folder)
+
+
+def _fit(sizes, times) -> float:
+    return float(np.polyfit(np.log(sizes), np.log(times), 1)[0])
+
+
+def bench_scaling(manifest, config, tmp: Path, workers: int, quick: bool) -> None:
+    """Time at three sizes (×1, ×10, ×100) and the fitted exponent."""
+    print("4. Scaling (time at ×1, ×10, ×100; time ~ n^b fitted on the three):")
+    if not quick:
+        secs = [12.0, 120.0, 1200.0]
+        sub = subset(manifest, 3)
+        ms = [cropped(sub, tmp, s_, 3) for s_ in secs]
+        sizes = [3 * int(round(s_ * 300)) for s_ in secs]
+        times = [run(m, config, tmp / "cache_scale", scheduler=None)[0] for m in ms]
+        print(
+            "   session duration 12 s / 120 s / 20 min, 3 sessions, serial (n = samples):"
+        )
+        print_scaling("   serial", sizes, times, _fit(sizes, times))
+    k, secs_ = (1, 3.0) if quick else (1, 12.0)
+    counts = [k, 10 * k, 100 * k]
+    ms = [cropped(manifest, tmp, secs_, c) for c in counts]
+    sizes = [c * int(round(secs_ * 300)) for c in counts]
+    print(
+        f"   session count {counts[0]} / {counts[1]} / {counts[2]} sessions of "
+        f"{secs_:g} s (n = samples; start-up included):"
+    )
+    for name, kw in (
+        ("serial", {"scheduler": None}),
+        ("processes", {"scheduler": "processes", "workers": workers}),
+        ("dask", {"scheduler": "dask", "workers": workers}),
+    ):
+        times = [run(m, config, tmp / "cache_scale", **kw)[0] for m in ms]
+        print_scaling(f"   {name}", sizes, times, _fit(sizes, times))
+        print(
+            f"   {'':18s} {', '.join(f'{c}: {t:.2f} s' for c, t in zip(counts, times))}"
+        )
+
+
+def paper_size(
+    cmp: dict, samples: int, workers: int, duration_s: float, n: int
+) -> float:
+    """Print the paper-size estimates (fixed start-up + measured cost per sample)."""
+    scale = PAPER_SAMPLES / samples
+    print(
+        f"3. Paper-size design ({PAPER_SESSIONS} sessions, {PAPER_SAMPLES:,} samples), "
+        f"{workers} workers, extrapolated from {n} measured sessions of {duration_s:g} s "
+        "(start-up + cost per sample):"
+    )
+    serial = cmp["serial"] * scale
+    print(f"   serial     {serial:7.1f} s")
+    est = {}
+    for name, start in (("dask", "startup"), ("processes", "pstartup")):
+        t0 = min(cmp[start], cmp[name])
+        est[name] = t0 + (cmp[name] - t0) * scale
+        print(
+            f"   {name:<10} {est[name]:7.1f} s ({PAPER_SAMPLES / est[name] / 1e6:.2f} M "
+            f"samples/s; speed-up over serial {serial / est[name]:.2f})"
+        )
+    best = cmp["startup"] + cmp["cpu_serial"] / workers * scale
+    print(
+        f"   best case (serial CPU time per sample / {workers} idle cores + "
+        f"cluster start): {best:7.1f} s"
+    )
+    for name, start in (("dask", "startup"), ("processes", "pstartup")):
+        # scale * n: sessions of the measured length that hold the paper's samples
+        cpu = cmp[start] + cmp[f"ses_{name}"] * scale * n / workers
+        print(
+            f"   {name:<10} from CPU accounting (start-up + the workers' CPU s per "
+            f"session × {PAPER_SESSIONS} / {workers} idle cores): {cpu:7.1f} s "
+            f"(speed-up over serial {cmp['cpu_serial'] * scale / cpu:.2f})"
+        )
+    return est["dask"]
 
 
 # --------------------------------------------------------------------------- main
@@ -449,6 +624,10 @@ def main() -> None:
     ap.add_argument("--keep", action="store_true", help="keep the temporary folder")
     args = ap.parse_args()
     logging.getLogger("distributed").setLevel(logging.ERROR)
+    # cropped sessions may be clipped: that warning, once per session, is not timed
+    warnings.filterwarnings("ignore", category=QualityWarning)
+    # in the workers too (QualityWarning is a UserWarning; the workers start after this)
+    os.environ["PYTHONWARNINGS"] = "ignore::UserWarning"
 
     if args.quick:
         design = simulate.CohortDesign(groups={"Kainate": 1, "Healthy": 1})
@@ -485,31 +664,7 @@ def main() -> None:
             subset(manifest, n_cmp), config, tmp, args.workers, n_cmp * per_session
         )
         print()
-        # paper-size: fixed cluster start-up + the measured per-sample cost of the dask run
-        per_sample = (cmp["dask"] - cmp["startup"]) / (n_cmp * per_session)
-        est = cmp["startup"] + per_sample * PAPER_SAMPLES
-        print(
-            f"3. Paper-size design ({PAPER_SESSIONS} sessions, {PAPER_SAMPLES:,} samples), "
-            f"dask, {args.workers} workers:"
-        )
-        print(
-            f"   extrapolated from {n_cmp} measured sessions of {duration_s:g} s: "
-            f"{est:7.1f} s ({PAPER_SAMPLES / est / 1e6:.2f} M samples/s)"
-        )
-        if args.quick:
-            print(
-                "   (smoke run: 30-s sessions carry more per-session overhead than 20-min "
-                "ones; run without --quick for the estimate)"
-            )
-        # best case: the serial run's CPU cost per sample, spread perfectly over the
-        # workers of an idle machine, plus starting the cluster
-        cpu_est = cmp["startup"] + cmp["cpu_serial"] / args.workers * (
-            PAPER_SAMPLES / (n_cmp * per_session)
-        )
-        print(
-            f"   best case (serial CPU time per sample / {args.workers} idle cores + "
-            f"cluster start): {cpu_est:7.1f} s"
-        )
+        est = paper_size(cmp, n_cmp * per_session, args.workers, duration_s, n_cmp)
         if args.full:
             t_full, _, _ = run(
                 manifest,
@@ -523,6 +678,10 @@ def main() -> None:
                 f"   measured: {t_full:7.1f} s ({PAPER_SAMPLES / t_full / 1e6:.2f} M samples/s)"
             )
         if args.quick:
+            print(
+                "   (smoke run: 30-s sessions carry more per-session overhead than 20-min "
+                "ones; run without --quick for the estimate)"
+            )
             print(f"   target < {TARGET_S:.0f} s: not assessed by a smoke run")
         else:
             verdict = "MET" if est < TARGET_S else "NOT MET"
@@ -530,6 +689,8 @@ def main() -> None:
                 f"   target < {TARGET_S:.0f} s on {args.workers} cores: {verdict} "
                 f"(ratio to target {est / TARGET_S:.2f})"
             )
+        print()
+        bench_scaling(manifest, config, tmp, args.workers, args.quick)
     finally:
         if args.keep:
             print(f"kept in {tmp}")

@@ -3,11 +3,13 @@ r"""Run a cohort: one task per session on any scheduler, a disk cache, no lost s
 :func:`run_cohort` submits one task per session that is not in the cache and collects
 the results as they complete, through the same two calls (``submit``, then
 ``as_completed``) whatever runs them: this process (serial), a local process pool, or a
-``dask.distributed`` cluster. Every result is written to the cache as soon as it
-arrives, atomically (a temporary file renamed into place), so a killed run leaves no
-corrupt entry and a restarted run resumes where it stopped. A session that cannot be
-read or computed becomes a row with ``status = "failed"``, its ``error`` and NaN
-features; the others complete.
+``dask.distributed`` cluster. A session is submitted as soon as its cache entry is
+found missing (the back end starts at the first one), so the workers compute while
+the parent still hashes the following files. Every result is written to the cache as
+soon as it arrives, atomically (a temporary file renamed into place), so a killed run
+leaves no corrupt entry and a restarted run resumes where it stopped. A session that
+cannot be read or computed becomes a row with ``status = "failed"``, its ``error`` and
+NaN features; the others complete.
 """
 
 from __future__ import annotations
@@ -333,6 +335,71 @@ def _assemble(
     return xr.Dataset(data, coords=coords, attrs=attrs)
 
 
+class _Run:
+    """The sessions of one :func:`run_cohort`: cache look-ups, tasks and results.
+
+    The back end is started at the first session missing from the cache (a run that
+    finds every session cached starts none); each task is one session, read by path in
+    the worker, which sends back only the session's feature Dataset (a few scalars).
+    """
+
+    def __init__(
+        self, cache: Path, root: str, config: FeatureConfig, scheduler, workers
+    ):
+        self.cache, self.root, self.config = cache, root, config
+        self.scheduler, self.workers = scheduler, workers
+        self.spec = feature_specs(config)
+        self.backend = None
+        self.futures: dict[Any, str] = {}
+        self.results: dict[str, dict[str, Any]] = {}
+        self.keys: dict[str, str | None] = {}
+        self.digests: dict[str, str | None] = {}
+        self.n_cached = 0
+
+    @property
+    def n_computed(self) -> int:
+        return len(self.futures)
+
+    def lookup_or_submit(self, row: dict, bar) -> None:
+        """Take the session from the cache, or submit its task."""
+        sid = row["session"]
+        key = cache_key(row, self.root, self.config, digests=self.digests)
+        self.keys[sid] = key
+        hit = _cache_get(self.cache, key, self.spec)
+        if hit is not None:
+            self.results[sid] = {"status": "ok", "error": "", "features": hit}
+            self.n_cached += 1
+            bar.update()
+            return
+        if self.backend is None:
+            self.backend = _backend(self.scheduler, self.workers)
+        task = self.backend.submit(compute_session, row, self.root, self.config)
+        self.futures[task] = sid
+
+    def collect(self, bar) -> None:
+        """Gather the results as they complete; cache each one as it arrives."""
+        if not self.futures:
+            return
+        for fut in self.backend.as_completed(list(self.futures)):
+            sid = self.futures[fut]
+            try:
+                res = fut.result()
+            except Exception as exc:  # the worker itself died
+                res = {
+                    "status": "failed",
+                    "error": f"{type(exc).__name__}: {exc}",
+                    "features": None,
+                }
+            if res["status"] == "ok" and self.keys[sid] is not None:
+                _cache_put(self.cache, self.keys[sid], res["features"])
+            self.results[sid] = res
+            bar.update()
+
+    def close(self) -> None:
+        if self.backend is not None:
+            self.backend.close()
+
+
 def run_cohort(
     manifest,
     config: FeatureConfig | None = None,
@@ -359,7 +426,8 @@ def run_cohort(
         existing scheduler, or a ``distributed.Client`` (left open). The same tasks are
         submitted in every case and give identical features.
     workers : int, optional
-        Number of worker processes.
+        Number of worker processes; each runs one session at a time, its numba
+        kernels and BLAS on one thread.
     cache_dir : path-like, optional
         Per-session cache (default ``.tiltlab-cache`` beside the manifest). Entries are
         keyed by :func:`cache_key`: a rerun recomputes only sessions whose file,
@@ -402,56 +470,18 @@ def run_cohort(
     root = str(manifest.root)
     cache = Path(cache_dir) if cache_dir is not None else manifest.root / DEFAULT_CACHE
     rows = list(manifest.rows())
-    spec = feature_specs(config)
-    results: dict[str, dict[str, Any]] = {}
-    keys: dict[str, str | None] = {}
-    digests: dict[str, str | None] = {}
-    todo = []
-    for row in rows:
-        key = cache_key(row, root, config, digests=digests)
-        keys[row["session"]] = key
-        hit = _cache_get(cache, key, spec)
-        if hit is not None:
-            results[row["session"]] = {
-                "status": "ok",
-                "error": "",
-                "features": hit,
-            }
-        else:
-            todo.append(row)
-    n_cached = len(results)
-    bar = tqdm(
-        total=len(rows),
-        initial=n_cached,
-        desc="sessions",
-        unit="session",
-        disable=not progress,
-    )
-    if todo:
-        backend = _backend(scheduler, workers)
-        try:
-            futures = {
-                backend.submit(compute_session, row, root, config): row["session"]
-                for row in todo
-            }
-            for fut in backend.as_completed(list(futures)):
-                sid = futures[fut]
-                try:
-                    res = fut.result()
-                except Exception as exc:  # the worker itself died
-                    res = {
-                        "status": "failed",
-                        "error": f"{type(exc).__name__}: {exc}",
-                        "features": None,
-                    }
-                if res["status"] == "ok" and keys[sid] is not None:
-                    _cache_put(cache, keys[sid], res["features"])
-                results[sid] = res
-                bar.update()
-        finally:
-            backend.close()
+    bar = tqdm(total=len(rows), desc="sessions", unit="session", disable=not progress)
+    run = _Run(cache, root, config, scheduler, workers)
+    try:
+        # a session is submitted as soon as its cache entry is found missing: the
+        # workers start, and compute, while the following files are still hashed
+        for row in rows:
+            run.lookup_or_submit(row, bar)
+        run.collect(bar)
+    finally:
+        run.close()
     bar.close()
-    ds = _assemble(manifest, config, results, len(todo), n_cached)
+    ds = _assemble(manifest, config, run.results, run.n_computed, run.n_cached)
     if out is not None:
         save_features(ds, out)
     if progress:
