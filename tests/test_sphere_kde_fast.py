@@ -114,3 +114,25 @@ def test_mass_kde_equals_brute_force_sum_tilted_grid_and_tol(tol):
     ref = _brute_mass_kde(x, w, 0.08, grid, tol=tol)
     np.testing.assert_allclose(got, ref, rtol=1e-13, atol=1e-13 * ref.max())
     assert np.array_equal(got > 0, ref > 0)
+
+
+def test_kde_does_not_depend_on_the_number_of_threads():
+    """The chunking of the kernel sum is fixed, so the density is bit-identical with
+    one thread (a cohort worker) and with several."""
+    import numba
+
+    from tiltlab import sphere
+
+    rng = np.random.default_rng(7)
+    x = rng.normal(size=(5000, 3)) + [0.0, 0.0, 2.0]
+    x /= np.linalg.norm(x, axis=1, keepdims=True)
+    before = numba.get_num_threads()
+    try:
+        numba.set_num_threads(1)
+        one = sphere.kde(x, cell_deg=2.0)
+        numba.set_num_threads(numba.config.NUMBA_NUM_THREADS)
+        many = sphere.kde(x, cell_deg=2.0)
+    finally:
+        numba.set_num_threads(before)
+    np.testing.assert_array_equal(one.density, many.density)
+    assert one.h == many.h

@@ -14,7 +14,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import NamedTuple
 
-import numba
 import numpy as np
 
 from .. import _validate
@@ -237,6 +236,12 @@ class _KDESettings(NamedTuple):
     quadrature: str = "mass"
 
 
+#: samples are split into this many chunks, each summed into its own accumulator (in
+#: parallel), then the accumulators are added: a fixed number, so that the sum's
+#: rounding, hence the density, does not depend on the number of threads
+_CHUNKS = 8
+
+
 def _settings(options: dict, caller: str) -> _KDESettings:
     """Return the settings record of keyword ``options`` (a ``TypeError`` for others)."""
     unknown = sorted(set(options) - set(_KDESettings._fields))
@@ -279,7 +284,7 @@ def _scatter(x, w, h, grid: EqualAreaGrid, settings: _KDESettings) -> np.ndarray
     per = 2 if quadrature == "mass" else 1  # accumulator (+ scratch) per chunk
     nchunk = max(
         1,
-        min(numba.get_num_threads(), x.shape[0], 4 * _MAX_CELLS // (per * ncell)),
+        min(_CHUNKS, x.shape[0], 4 * _MAX_CELLS // (per * ncell)),
     )
     out = np.zeros((nchunk, ncell))
     scratch = np.empty((nchunk, ncell) if quadrature == "mass" else (nchunk, 1))
