@@ -50,7 +50,7 @@ from pathlib import Path
 
 import numpy as np
 
-from tiltlab import behavior, cohort, filters, io, schema, simulate, sphere, units
+from tiltlab import behavior, cohort, filters, io, simulate, sphere, units
 from tiltlab.cohort import features as _features
 from tiltlab.cohort import run as _run
 from tiltlab.cohort.schedulers import backend
@@ -64,7 +64,6 @@ TARGET_S = 180.0
 STAGES = (
     "read session",
     "read tumble test",
-    "validate",
     "calibration",
     "filter (orientation)",
     "tilt (gravity)",
@@ -225,10 +224,8 @@ def staged_features(
     t1a = t()
     cal = _run._calibration_of(row, str(root))  # read once per subject and process
     t1 = t()
-    schema.validate(rec, allow_nan=True)
-    for v in ("acc", "gyr"):
-        assert np.isfinite(rec[v].values).all()
-    t2 = t()
+    # (no validation stage: load_session validated the Recording, and run_cohort's
+    # session_features(validate=False) does not validate it again)
     rec, _ = _features._corrected(rec, config, cal)
     t3 = t()
     q = filters.estimate(
@@ -278,7 +275,7 @@ def staged_features(
     for th in config.tilt_thresholds_deg:
         float(np.mean(tilt_deg > th))
     t10 = t()
-    marks = (t0, t1a, t1, t2, t3, t4, t5, t6, t7, t8, t9, t10)
+    marks = (t0, t1a, t1, t3, t4, t5, t6, t7, t8, t9, t10)
     for name, a, b in zip(STAGES, marks[:-1], marks[1:]):
         clock[name] += b - a
     return out, rec.sizes["time"]
@@ -337,17 +334,15 @@ def bench_stages(manifest: cohort.Manifest, n: int, config) -> dict:
         f"   (load_session + session_features as run_cohort calls them: "
         f"{t_ref / len(rows):.3f} s/session, {samples / t_ref / 1e6:.2f} M samples/s)"
     )
-    # how much of "read session" is the reader's own validation (session_features
-    # validates the same Recording again: the "validate" stage)
+    # how much of "read session" is the reader's own validation, the only one
     path = cohort.session_path(rows[0]["file"], root)
     t_raw = min(_timed(lambda: io.load_netcdf(path)) for _ in range(3))
     t_read = min(_timed(lambda: cohort.load_session(rows[0], root)) for _ in range(3))
     per = total / len(rows)
-    twice = (t_read - t_raw) + clock["validate"] / len(rows)
+    once = t_read - t_raw
     print(
         f"   read session = file {t_raw:.3f} s + the reader's validation "
-        f"{t_read - t_raw:.3f} s; validation in all (twice per session): "
-        f"{twice:.3f} s/session ({twice / per:.0%} of the pipeline)"
+        f"{once:.3f} s, the session's only validation ({once / per:.0%} of the pipeline)"
     )
     if mismatch:
         print(
