@@ -173,6 +173,39 @@ def _screenshot(browser, page: str) -> None:
     out.write_bytes(base64.b64decode(shot["data"]))
 
 
+def _figure_problems(browser) -> list[str]:
+    """Figures of executed cells: numbered caption, alt text, sharp on a dense screen."""
+    figs = browser.execute_script(
+        """
+        return Array.from(document.querySelectorAll('main .cell_output img')).map(i => {
+            const fig = i.closest('figure');
+            const num = fig && fig.querySelector('figcaption .caption-number');
+            const cap = fig && fig.querySelector('figcaption');
+            // textContent: a solution's figure sits in a closed toggle
+            return [i.currentSrc || i.src, num ? num.textContent : '',
+                    cap ? cap.textContent : '', i.getAttribute('alt') || '',
+                    i.naturalWidth, i.getBoundingClientRect().width];
+        });
+        """
+    )
+    out = []
+    for src, number, caption, alt, natural, shown in figs:
+        name = src.rsplit("/", 1)[-1][:16]
+        if not re.match(r"Fig\.\s*\d+", number):
+            out.append(f"figure {name} has no numbered caption")
+        elif len(caption) - len(number) < 40:
+            out.append(f"figure {name}: caption too short to explain it ({caption!r})")
+        if len(alt.strip()) < 10:
+            out.append(f"figure {name} has no alt text")
+        if not src.endswith(".svg") and shown > 0 and natural < 1.5 * shown:
+            # (a figure in a closed toggle has no width: nothing to compare)
+            out.append(
+                f"figure {name}: {natural} px shown at {shown:.0f} px "
+                f"({natural / shown:.1f}x): blurred on a high-density screen"
+            )
+    return out
+
+
 @pytest.mark.parametrize("page", chapter_pages())
 def test_page_renders(server, browser, page):
     browser.get_log("browser")  # forget the previous page's messages
@@ -211,18 +244,21 @@ def test_page_renders(server, browser, page):
             f"a {len(m.group(0))}-character float in an output: {m.group(0)}"
         )
 
-    # every image is present, loaded, non-empty and not shrunk below 70 % of its width
+    # every image is present, loaded, non-empty and not shrunk below 70 % of the width
+    # it declares (a retina PNG declares half its pixel width)
     imgs = browser.execute_script(
-        "return Array.from(document.querySelectorAll('main img')).map(i => [i.currentSrc || i.src, i.complete, i.naturalWidth, i.naturalHeight, i.getBoundingClientRect().width])"
+        "return Array.from(document.querySelectorAll('main img')).map(i => [i.currentSrc || i.src, i.complete, i.naturalWidth, i.naturalHeight, i.getBoundingClientRect().width, parseFloat(i.style.width) || parseFloat(i.getAttribute('width')) || i.naturalWidth])"
     )
-    for src, complete, w, h, shown in imgs:
+    for src, complete, w, h, shown, declared in imgs:
         name = src.rsplit("/", 1)[-1]
         if not (complete and w > 0 and h > 0):
             problems.append(f"image not loaded {name}")
-        elif shown < 0.7 * w:
+        elif shown < 0.7 * declared:
             problems.append(
-                f"image {name} shown at {shown:.0f} of {w} px ({shown / w:.0%}): its text shrinks"
+                f"image {name} shown at {shown:.0f} of {declared:.0f} px "
+                f"({shown / declared:.0%}): its text shrinks"
             )
+    problems += _figure_problems(browser)
     if page.startswith("notebooks/") and not imgs:
         problems.append("a chapter without any figure")
 
