@@ -96,3 +96,18 @@ def test_loaded_recordings_are_independent(data_mirror):
     a["acc"][:] = np.nan
     b = d.load_fayat_example()
     assert np.isfinite(b.acc.values).all()
+
+
+def test_broad_coverage_partitions_the_39_trials(data_mirror):
+    """Every trial of trials.json is either registered or listed as missing, by kind."""
+    from tiltlab import datasets
+
+    cov = datasets.broad_coverage()
+    every = [n for v in cov.values() for n in v]
+    assert sorted(every) == list(range(1, 40))
+    assert set(cov["undisturbed"]) | set(cov["disturbed"]) == set(
+        datasets.broad_trials()
+    )
+    groups = datasets.broad_trial_groups()
+    assert all("undisturbed" in groups[n] for n in cov["undisturbed"])
+    assert not any("undisturbed" in groups[n] for n in cov["disturbed"])

@@ -40,6 +40,7 @@ __all__ = [
     "broad_trials",
     "broad_trial_groups",
     "broad_trial_kind",
+    "broad_coverage",
     "load_broad_trial",
     "load_fayat_example",
     "load_fayat_tumble",
@@ -294,6 +295,34 @@ def broad_trial_groups() -> dict[int, list[str]]:
         key = Path(name).stem
         out[n] = list(info[key]["groups"]) if key in info else []
     return out
+
+
+def broad_coverage() -> dict[str, list[int]]:
+    """Say which of BROAD's trials this installation registers and which it lacks.
+
+    BROAD lists 39 trials in ``trials.json``; the registry holds those whose files could
+    be obtained. Chapters that average over BROAD trials use this to state their subset.
+
+    Returns
+    -------
+    dict of str to list of int
+        ``undisturbed`` and ``disturbed``: the registered trial numbers of each kind;
+        ``missing_undisturbed`` and ``missing_disturbed``: the trials of each kind that
+        ``trials.json`` lists and the registry lacks (all sorted).
+    """
+    info = json.loads(fetch("broad/trials.json").read_text())["trials"]
+    have = set(broad_trials())
+    out: dict[str, list[int]] = {
+        "undisturbed": [],
+        "disturbed": [],
+        "missing_undisturbed": [],
+        "missing_disturbed": [],
+    }
+    for key, entry in info.items():
+        n = int(key.split("_", 1)[0])
+        kind = "undisturbed" if "undisturbed" in entry["groups"] else "disturbed"
+        out[kind if n in have else f"missing_{kind}"].append(n)
+    return {k: sorted(v) for k, v in out.items()}
 
 
 _BROAD_MOTIONS = ("rotation", "translation", "combined")
