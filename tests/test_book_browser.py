@@ -322,6 +322,24 @@ def test_page_renders(server, browser, page):
                 if hidden < 0
                 else "fewer than 2 hidden solutions"
             )
+        # every exercise has its answer in a closed "Solution N: the answer" dropdown
+        n_ex, n_answers = browser.execute_script(
+            """
+            const sec = Array.from(document.querySelectorAll('main section'))
+                .find(s => s.querySelector(':scope > h2') &&
+                           /Exercises/.test(s.querySelector(':scope > h2').innerText));
+            if (!sec) return [0, 0];
+            const ol = sec.querySelector('ol');
+            const answers = Array.from(sec.querySelectorAll('details.sd-dropdown'))
+                .filter(d => !d.open && /^Solution \\d+: the answer/.test(
+                    d.querySelector('summary').textContent.trim())).length;
+            return [ol ? ol.querySelectorAll(':scope > li').length : 0, answers];
+            """
+        )
+        if n_answers < n_ex:
+            problems.append(
+                f"{n_ex} exercises but {n_answers} closed 'Solution N: the answer' toggles"
+            )
     elif page == "intro.html" and h1.strip() != "Introduction":
         problems.append(f"the home page is titled {h1!r}, not 'Introduction'")
 
