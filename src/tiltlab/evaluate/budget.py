@@ -6,12 +6,12 @@ Three measured parts of the tilt error of several estimates of one recording:
   :math:`\epsilon_k = \theta_k\, u_k` (angle :math:`\theta_k` between the estimated
   and the reference gravity-up directions, about the unit axis
   :math:`u_k \propto g^{\mathrm{ref}}_k \times \hat g_k`, sensor frame) is split by a
-  zero-phase low-pass at ``cutoff_hz`` into a slow part and the fast rest. A
-  gyroscope integrates accurately over a fraction of a second (its noise and bias
-  move the tilt by hundredths of a degree there), so every estimator that follows
-  its gyroscope has the *same* fast part: the reference's own fast errors (marker
-  noise, a time offset between the two clocks under rotation), which no inertial
-  estimator can remove.
+  zero-phase low-pass at ``cutoff_hz`` into a slow part and the fast rest. Over a
+  fraction of a second an estimate follows its gyroscope integration, so estimators
+  that share a gyroscope share their fast part when that integration is accurate
+  (compare their ``fast`` values): it is then the reference's own fast errors
+  (marker noise, a time offset between the two clocks under rotation), which no
+  inertial estimator can remove.
 * **spread.** The RMS tilt difference :math:`s_m` between estimate :math:`m` and a
   baseline :math:`b` bounds how much their errors can differ: per sample
   :math:`|\theta^m_k - \theta^b_k| \le \angle(\hat g^m_k, \hat g^b_k)` (the
