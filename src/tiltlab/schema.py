@@ -224,6 +224,13 @@ def make_recording(
                 "units": "1",
                 "long_name": "reference orientation, sensor to world",
                 "frame": "sensor->world",
+                # what the sensor axes point to travels with the orientation, as it
+                # does on the filters' estimates (tilt from it is labelled alike)
+                **(
+                    {"axis_labels": list(frame_attrs["axis_labels"])}
+                    if "axis_labels" in frame_attrs
+                    else {}
+                ),
             },
         )
     _set_ranges(data_vars, opts.ranges)

@@ -77,10 +77,33 @@ def running_rms(values, window: int) -> np.ndarray:
         return np.where(n > 0, np.sqrt(s / np.where(n > 0, n, 1.0)), np.nan)
 
 
+def _ticks_within(lo: float, hi: float, subs: tuple[float, ...]) -> int:
+    """How many values ``m · 10^k`` (``m`` in ``subs``) lie in ``[lo, hi]``.
+
+    Parameters
+    ----------
+    lo, hi : float
+        Positive axis limits.
+    subs : tuple of float
+        Mantissas of the candidate ticks.
+
+    Returns
+    -------
+    int
+    """
+    if not (lo > 0 and np.isfinite(hi)):
+        return len(subs)
+    k = np.arange(np.floor(np.log10(lo)), np.ceil(np.log10(hi)) + 1)
+    values = np.outer(10.0**k, subs).ravel()
+    return int(np.sum((values >= lo * (1 - 1e-9)) & (values <= hi * (1 + 1e-9))))
+
+
 def plain_log_ticks(ax, axis: str = "y"):
     """Label a log-scaled axis with plain numbers (0.5, 1, 2, 5 …).
 
-    Plain numbers instead of powers of ten, and no minor labels, so that short decades do not crowd their labels.
+    Plain numbers instead of powers of ten, and no minor labels, so that short decades do
+    not crowd their labels; a range too short for three of 1, 2, 5 × 10^k (a colour bar
+    over less than a decade) is labelled at every integer mantissa (2, 3, 4 …) instead.
 
     Parameters
     ----------
@@ -99,6 +122,8 @@ def plain_log_ticks(ax, axis: str = "y"):
     lo, hi = sorted(ax.get_ylim() if axis == "y" else ax.get_xlim())
     decades = np.log10(hi / lo) if lo > 0 else np.inf
     subs = (1.0, 2.0, 5.0) if decades <= 2.5 else (1.0,)
+    if _ticks_within(lo, hi, subs) < 3:  # a short range: every integer mantissa
+        subs = tuple(float(k) for k in range(1, 10))
     target.set_major_locator(ticker.LogLocator(base=10.0, subs=subs))
     target.set_major_formatter(ticker.FuncFormatter(lambda v, _: f"{v:g}"))
     target.set_minor_formatter(ticker.NullFormatter())

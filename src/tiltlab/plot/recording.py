@@ -54,8 +54,18 @@ def _thicken(legend, lw: float = 2.0):
     """
     if legend is not None:
         for line in legend.get_lines():
-            line.set_linewidth(max(lw, line.get_linewidth()))
+            width = max(lw, line.get_linewidth())
+            style = line.get_linestyle()
+            line.set_linewidth(width)
+            if style in _LEGEND_DASHES:
+                # dashes scale with the width: a short legend sample of a thick
+                # dash-dot line would show one long dash and look solid
+                line.set_dashes([d / width for d in _LEGEND_DASHES[style]])
     return legend
+
+
+#: Dash patterns (points, at any width) that fit a legend sample several times.
+_LEGEND_DASHES = {"--": (4.0, 2.0), "-.": (4.0, 1.5, 1.2, 1.5), ":": (1.2, 1.5)}
 
 
 #: Default width (inches) of the full-width figures: the book's column at 100 dpi.
@@ -246,6 +256,9 @@ def series_panels(
         Abscissa label and units.
     styles : mapping, optional
         Line label → keyword arguments of ``ax.plot`` (e.g. ``{"optical": dict(lw=2, color="0.7")}``).
+        Lines named after a sensor axis (``x``, ``y``, ``z``, ``w``, also followed by a
+        description) get the book's fixed axis colours, as in :func:`plot_recording`,
+        unless a style gives another colour.
     ylim : mapping, optional
         Panel label → y limits.
     logy : bool or sequence of str
@@ -285,7 +298,14 @@ def series_panels(
                 raise ValueError(
                     f"{name!r}/{lab!r}: {len(yy)} values for {len(x)} times"
                 )
-            ax.plot(x, yy, label=lab, **({"lw": 0.8} | dict(styles.get(lab, {}))))
+            colour = (
+                {"color": _AXIS_COLOURS[str(lab).split(" ")[0]]}
+                if (str(lab).split(" ")[0] in _AXIS_COLOURS)
+                else {}
+            )
+            ax.plot(
+                x, yy, label=lab, **({"lw": 0.8} | colour | dict(styles.get(lab, {})))
+            )
         u = units.get(name) if isinstance(units, Mapping) else units
         ax.set_ylabel(label(name, u if u is not None else units_of(first)))
         if logy is True or (not isinstance(logy, bool) and name in logy):
@@ -443,5 +463,6 @@ def speed_histogram(
             )
     ax.set_xlabel(label("log10 angular speed", u))
     ax.set_ylabel("density" if density else "count")
-    legend_if_many(ax)
+    # beside the axes, never over the histograms or the threshold lines
+    legend_if_many(ax, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
     return ax
