@@ -10,7 +10,10 @@ chapter's rerun is described by ``tools/reruns/<notebook stem>.py``, which defin
 
 and optionally ``check(nb_path: Path, params: dict) -> str``, which compares a number the
 executed chapter printed with the package computing it directly, so that a rerun cannot
-silently analyse the wrong thing. Every chapter must have a rerun module. A module may
+silently analyse the wrong thing, and whose checks include the chapter's glued prose
+(its summary's computed statements agree with the tables they summarise). Every rerun
+also checks that every value the chapter's prose glues was produced on the other data.
+Every chapter must have a rerun module. A module may
 also define ``VARIANTS``: a dict of further reruns, name → ``prepare`` function (with an
 optional ``check_<name>``), e.g. the chapter on a converted recording from another lab.
 
@@ -61,6 +64,8 @@ def _jobs(stem: str, module) -> list[tuple[str, object, object]]:
 
 
 def main(argv: list[str]) -> int:
+    from reruns._common import check_glued_prose
+
     wanted = set(argv)
     failures = ran = 0
     with tempfile.TemporaryDirectory() as tmp:
@@ -96,6 +101,7 @@ def main(argv: list[str]) -> int:
                         progress_bar=False,
                     )
                     note = check(out, params) if check else "completed"
+                    note = f"{note}; {check_glued_prose(out)}"
                     print(
                         f"   ok in {time.perf_counter() - t0:.0f} s: {note}", flush=True
                     )
