@@ -3,10 +3,13 @@ coarser lattice and with the heading maps of another trial."""
 
 from __future__ import annotations
 
+import re
 import warnings
 from pathlib import Path
 
-from ._common import printed
+import numpy as np
+
+from ._common import glued, glued_float, printed
 from ._foreign import convert
 
 PARAMS = {
@@ -22,7 +25,8 @@ PARAMS = {
 def check(nb_path: Path, params: dict) -> str:
     """The immobile fraction the chapter prints (over the samples with a tilt) equals the
     package's immobility rule applied directly, and the rule it names is the one the
-    recording allows (the gyroscope's, or the accelerometer's without one)."""
+    recording allows (the gyroscope's, or the accelerometer's without one); the glued
+    statements of the prose agree with what they summarise (see :func:`_prose`)."""
     from tiltlab import behavior, datasets, filters
 
     rec = datasets.load(params["SOURCE"])
@@ -43,7 +47,73 @@ def check(nb_path: Path, params: dict) -> str:
     rule = printed(nb_path, r"immobility: (.+)", "immobility rule")[0]
     if rule.strip() != immobile.attrs["rule_description"]:
         raise AssertionError(f"chapter used the rule {rule!r}")
-    return f"immobile fraction {got:.1%} (package: {expected:.1%}; {rule.strip()})"
+    g = filters.gravity(q)[valid]
+    notes = _prose(nb_path, params, g, immobile[valid].values)
+    return f"immobile fraction {got:.1%} (package: {expected:.1%}; {rule.strip()}); {notes}"
+
+
+def _close(got: float, expected: float, what: str, rel: float = 1e-6) -> None:
+    if not np.isclose(got, expected, rtol=rel, atol=1e-12):
+        raise AssertionError(f"chapter glued {what} = {got}, recomputed {expected}")
+
+
+def _word(text: str, expected: str, what: str) -> None:
+    if expected not in text:
+        raise AssertionError(
+            f"chapter says {what} {text!r}; the numbers give {expected!r}"
+        )
+
+
+def _prose(nb_path: Path, params: dict, g, immobile: np.ndarray) -> str:
+    """Each glued summary statement against the numbers it summarises: the lattice's
+    area spread near its poles, the facet-count/area agreement of §3, the bootstrap and
+    movement-based-KDE verdicts, the stationarity of the thirds, and the exercises'
+    comparison words; the cheap ones recomputed with the package."""
+    from tiltlab import sphere
+
+    v = glued(nb_path)
+    _close(glued_float(v, "ch6_immobile_deg_s"), params["IMMOBILE_DEG_S"], "threshold")
+    # §2: where the large facet-area departures sit
+    mesh = sphere.sphere_mesh(params["N_LATTICE"])
+    z, ratio = mesh.centroids[:, 2], mesh.areas / mesh.areas.mean()
+    near = np.abs(z) > np.cos(np.radians(10.0))
+    if near.any() and not near.all():
+        where = np.ptp(ratio[near]) > np.ptp(ratio[~near])
+        _word(v["ch6_pole_areas"], "near the poles" if where else "away from", "areas")
+    # §3: largest |count/area − 1| over all, active and immobile samples
+    rel = []
+    for part in (g, g[~immobile], g[immobile]):
+        t = sphere.tilt_map(part, mesh=mesh)
+        a = sphere.visited_fraction(t, mesh)
+        rel.append(abs(sphere.visited_fraction(t, mesh, by="count") / a - 1))
+    _close(glued_float(v, "ch6_visited_reldiff_max") / 100, max(rel), "count/area")
+    # §4: the bootstrap sentence's comparison word matches its ratio
+    m = re.search(r"block cone is ([0-9.]+) times", v["ch6_boot_compare"])
+    if m:
+        word = "understates" if float(m.group(1)) > 1 else "does not understate"
+        _word(v["ch6_boot_compare"], word, "the i.i.d. bootstrap")
+    # §6: the movement-based KDE against the location-based one
+    step = np.degrees(sphere.angle(g.values[:-1], g.values[1:]))
+    _close(glued_float(v, "ch6_step_median_deg"), float(np.nanmedian(step)), "step")
+    h = np.degrees(sphere.reference_bandwidth(g))
+    _close(glued_float(v, "ch6_h_deg"), h, "bandwidth", rel=1e-4)
+    pct = glued_float(v, "ch6_mkde_diff_pct")
+    _word(v["ch6_mkde_verdict"], "nearly" if pct < 5 else "differ", "MKDE vs LKDE")
+    st3 = sphere.stationarity_thirds(g)
+    _close(glued_float(v, "ch6_thirds_max_angle"), st3.attrs["max_angle_deg"], "thirds")
+    # exercises: lattice comparison word and the bootstrap-block growth
+    ratio2 = glued_float(v, "ch6_ex2_lattice_ratio")
+    _word(v["ch6_ex2_word"], "larger" if ratio2 > 1 else "smaller", "coarse lattice")
+    cones = [float(x) for x in printed(nb_path, r"cone half-angle ([0-9.]+)°", "cones")]
+    m = re.search(r"by ([0-9.]+)° from .* by ([0-9.]+)° from", v["ch6_ex3_growth"])
+    if m and len(cones) == 4:  # i.i.d. + three blocks
+        d = np.diff(cones[1:])
+        _close(float(m.group(1)), round(d[0], 2), "cone growth", rel=0.02)
+        _close(float(m.group(2)), round(d[1], 2), "cone growth", rel=0.02)
+    return (
+        f"prose: count/area within {max(rel):.2%}, MKDE–LKDE {pct:.2f} % "
+        f"({v['ch6_mkde_verdict']}), thirds {st3.attrs['max_angle_deg']:.1f}°"
+    )
 
 
 def prepare_foreign(tmp: Path) -> dict:

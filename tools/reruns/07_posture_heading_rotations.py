@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ._common import printed
+from ._common import glued, glued_float, printed
 from ._foreign import convert
 
 #: the smaller numerical checks and tracks of every rerun
@@ -56,7 +56,11 @@ def check(nb_path: Path, params: dict) -> str:
         raise AssertionError(
             f"chapter says median |yaw| {got:.3f}°, trig.body_rotations gives {expected:.3f}°"
         )
-    return f"median |yaw| per {params['GYRO_STEP_S']:g} s step {got:.3f}° (package: {expected:.3f}°)"
+    notes = _prose(nb_path, params)
+    return (
+        f"median |yaw| per {params['GYRO_STEP_S']:g} s step {got:.3f}° "
+        f"(package: {expected:.3f}°); {notes}"
+    )
 
 
 def prepare_tag(tmp: Path) -> dict:
@@ -96,7 +100,84 @@ def check_tag(nb_path: Path, params: dict) -> str:
             f"trig.heading gives {expected:.2f}° over {az.size}"
         )
     printed(nb_path, r"has no gyroscope: the body rotations are skipped", "skip line")
-    return f"circular mean magnetic azimuth {got:.2f}° over {n} samples (package: {expected:.2f}°)"
+    notes = _prose(nb_path, params)
+    return (
+        f"circular mean magnetic azimuth {got:.2f}° over {n} samples "
+        f"(package: {expected:.2f}°); {notes}"
+    )
+
+
+def _close(got: float, expected: float, what: str, rel: float = 1e-6) -> None:
+    import numpy as np
+
+    if not np.isclose(got, expected, rtol=rel, atol=1e-12):
+        raise AssertionError(f"chapter glued {what} = {got}, recomputed {expected}")
+
+
+def _prose(nb_path: Path, params: dict) -> str:
+    """The glued summary statements against what they summarise: the worked examples of
+    Figs. 2 and 3 recomputed, the round-off residuals small, the head's median elevation,
+    the flapping/gliding medians and the exercises' counts and comparison words."""
+    import re
+
+    import numpy as np
+
+    from tiltlab import behavior, datasets, simulate, trig
+
+    v = glued(nb_path)
+    # worked examples: the number of caption values reproduced to the printed digits
+    a = trig.arc(np.pi / 6, np.pi / 6, np.pi / 2, np.pi / 3)
+    apex = trig.great_circle_apex(np.pi / 6, np.pi / 6, a.initial)
+    ours = np.pi / np.array([a.size, a.initial, a.final, *apex])
+    paper = ["3.637", "3.256", "19.023", "2.978", "1.784"]
+    n2 = sum(f"{o:.{len(p.split('.')[1])}f}" == p for o, p in zip(ours, paper))
+    w3, eta3 = trig.sequential_arc_from_yaw_pitch(np.pi / 3, np.pi / 6)
+    n3 = sum(f"{np.pi / x:.2f}" == p for x, p in zip([w3, eta3], ["2.80", "5.34"]))
+    if (glued_float(v, "ch7_fig2_n_agree"), glued_float(v, "ch7_fig3_n_agree")) != (
+        n2,
+        n3,
+    ):
+        raise AssertionError("the chapter's count of reproduced caption values is off")
+    for name in ("ch7_bridge_max", "ch7_eq5_max", "ch7_eq12_13_max"):
+        if glued_float(v, name) > 1e-10:
+            raise AssertionError(f"{name} is called round-off but is {v[name]}")
+    if glued_float(v, "ch7_vedba_rot_diff") > 1e-10:
+        raise AssertionError("VeDBA is said to be rotation invariant")
+    # the head recording's median elevation quoted in §4
+    head = datasets.load(params["HEAD_SOURCE"])
+    post = trig.posture(behavior.static_acceleration(head, window_s=params["WINDOW_S"]))
+    elev = float(np.degrees(np.nanmedian(post.elevation)))
+    _close(glued_float(v, "ch7_head_median_elev"), elev, "median elevation")
+    # §11: flapping and gliding medians of the simulated heave
+    heave = simulate.simulate_heave(
+        20.0, 100.0, period_s=params["FLAP_PERIOD_S"], rng=params["SEED"]
+    )
+    osc = trig.oscillation_stats(heave, level=1.0, window_s=1.0)
+    flap = np.asarray(osc.cv.time < 10.0)
+    cv = np.asarray(osc.cv)
+    _close(glued_float(v, "ch7_cv_flapping"), float(np.median(cv[flap])), "flapping CV")
+    _close(glued_float(v, "ch7_cv_gliding"), float(np.median(cv[~flap])), "gliding CV")
+    # the step-error sentence: its word matches its two numbers
+    m = re.search(
+        r"(grows|does not grow).*from ([0-9.]+)° to ([0-9.]+)°", v["ch7_step_error"]
+    )
+    if m and (m.group(1) == "grows") != (float(m.group(3)) > float(m.group(2))):
+        raise AssertionError(f"step error sentence: {v['ch7_step_error']!r}")
+    # exercises: VeDBA grows with the window; the count of tracks below the target
+    means = [float(behavior.dba(head, window_s=w).mean()) for w in (0.1, 0.5, 2.0)]
+    grow = "grow" if np.all(np.diff(means) > 0) else "do not all grow"
+    if v["ch7_ex1_grow"] != grow:
+        raise AssertionError(f"exercise 1 says {v['ch7_ex1_grow']!r}, means {means}")
+    errors = [
+        float(e) for e in printed(nb_path, r"([0-9.]+) m(?:,|$|\n)", "errors")[-3:]
+    ]
+    below = sum(e < glued_float(v, "ch7_ex_target") for e in errors)
+    if glued_float(v, "ch7_ex3_n_below") != below:
+        raise AssertionError(f"exercise 3 counts {v['ch7_ex3_n_below']} of {errors}")
+    return (
+        f"prose: Fig. 2 {n2}/5, Fig. 3 {n3}/2, median elevation {elev:.1f}°, "
+        f"CV flapping/gliding {np.median(cv[flap]):.2f}/{np.median(cv[~flap]):.2f}"
+    )
 
 
 VARIANTS = {"tag": prepare_tag}
