@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ._common import printed
+from ._common import glued, glued_float, printed
 
 # still-period settings of the rerun; the simulated holds last 4 s
 THRESHOLD, MIN_STILL_S = 3.0, 1.0
@@ -56,9 +56,13 @@ def check(nb_path: Path, params: dict) -> str:
     expected = calibration.robust_gyro_offset(rec)
     if not np.allclose(got, expected, atol=1e-3):
         raise AssertionError(f"chapter offset {got}, robust_gyro_offset {expected}")
+    values = glued(nb_path)
+    _still_summary(values, len(intervals), np.linalg.norm(expected))
+    _exercise_1(values, rec, params)
+    notes = _summary_checks(nb_path, values, rec, intervals)
     return (
         f"{len(intervals)} still periods, first-pass gyro offset "
-        f"{np.round(expected, 2).tolist()} deg/s (package agrees)"
+        f"{np.round(expected, 2).tolist()} deg/s (package agrees); {notes}"
     )
 
 
@@ -108,10 +112,165 @@ def check_tag(nb_path: Path, params: dict) -> str:
         raise AssertionError(
             f"chapter rms norm error {got} g, package {expected:.5f} g"
         )
+    values = glued(nb_path)
+    if "no gyroscope" not in values.get("ch3_still_summary", ""):
+        raise AssertionError(
+            "the still-period summary does not say the tag has no gyroscope"
+        )
+    if "skipped" not in values.get("ch3_ex1_answer", ""):
+        raise AssertionError(
+            "the answer to exercise 1 does not say the study is skipped"
+        )
+    notes = _summary_checks(nb_path, values, rec, intervals)
     return (
         f"{len(intervals)} still periods (accelerometer rule), offset fit rms norm "
-        f"error {got:.5f} g (package: {expected:.5f} g)"
+        f"error {got:.5f} g (package: {expected:.5f} g); {notes}"
     )
+
+
+def _near(a: float, b: float, what: str, tol: float) -> None:
+    if abs(a - b) > tol:
+        raise AssertionError(f"{what}: glued {a}, recomputed {b}")
+
+
+def _still_summary(values: dict, n_still: int, offset_norm: float) -> None:
+    """The glued still-period sentence states the detected count and offset norm."""
+    text = values.get("ch3_still_summary", "")
+    if f"finds {n_still} still periods" not in text:
+        raise AssertionError(f"still-period summary {text!r} does not state {n_still}")
+    if f"{offset_norm:.2f} °/s" not in text:
+        raise AssertionError(
+            f"still-period summary {text!r}: offset norm {offset_norm:.2f}"
+        )
+    if int(glued_float(values, "ch3_n_still")) != n_still:
+        raise AssertionError("glued still-period count differs from detect_static")
+
+
+def _exercise_1(values: dict, rec, params: dict) -> None:
+    """The answer's "same number of periods at every threshold" matches detect_static."""
+    from tiltlab import calibration
+
+    counts = {
+        len(
+            calibration.detect_static(
+                rec, threshold_deg_s=t, min_duration_s=params["MIN_STILL_S"]
+            )
+        )
+        for t in (1.0, 3.0, 10.0, 30.0)
+    }
+    same = values.get("ch3_ex1_same", "") == "never stops"
+    if same != (len(counts) == 1):
+        raise AssertionError(
+            f"exercise 1 says {values.get('ch3_ex1_same')!r}; period counts {counts}"
+        )
+
+
+def _summary_checks(nb_path: Path, values: dict, rec, intervals) -> str:
+    """The summary's glued statements agree with the values they summarise."""
+    import re
+
+    import numpy as np
+
+    from tiltlab import calibration, datasets
+    from tiltlab.calibration.published import (
+        LACANNA_REPORTED,
+        LACANNA_TABLES,
+        lacanna_drift_summary,
+    )
+
+    g = lambda name: glued_float(values, name)  # noqa: E731
+    # section 2: pose count and "solved exactly" iff three poses
+    res = calibration.tumble_calibration(rec, intervals=intervals)
+    if int(g("ch3_n_poses")) != res.fit.n:
+        raise AssertionError(f"glued {g('ch3_n_poses')} poses, fit uses {res.fit.n}")
+    exact = "solved exactly" in values["ch3_offset_summary"]
+    if exact != (res.fit.n == 3):
+        raise AssertionError(f"offset summary {values['ch3_offset_summary']!r}")
+    # "unmodelled scale and misalignment, not noise, bound the accuracy"
+    ratio_text = re.search(r"is (\d+) to (\d+) times", values["ch3_offset_summary"])
+    if ratio_text is None or int(ratio_text.group(1)) <= 1:
+        raise AssertionError(
+            f"systematic/statistical ratio {values['ch3_offset_summary']!r}"
+        )
+    # section 3: floor and ellipsoid statements
+    if (values["ch3_ell_below"] == "goes below") != (
+        g("ch3_ell_residual") < g("ch3_floor")
+    ):
+        raise AssertionError(
+            "ellipsoid 'below the floor' word contradicts the glued values"
+        )
+    if g("ch3_floor_gap") > 0.25 * g("ch3_floor"):
+        raise AssertionError(
+            "predicted and observed floors differ: 'the floor is set by "
+            "scale and misalignment' is not supported"
+        )
+    if g("ch3_three_point_gap") > 0.25 * g("ch3_three_point_max"):
+        raise AssertionError("three-point offset error does not follow the scale error")
+    # section 4: the temperature model beats a constant offset
+    if not g("ch3_temp_res_model") < g("ch3_temp_res_const"):
+        raise AssertionError("temperature model leaves more than the constant offset")
+    # section 5: LaCanna's summaries recomputed with the package
+    ours = np.asarray(lacanna_drift_summary())
+    ratio = ours / np.asarray(LACANNA_REPORTED.rate_deg_s)
+    n_ok = int(np.sum(np.abs(ratio - 1) < 0.02))
+    if int(g("ch3_n_repro")) != n_ok or int(g("ch3_n_summaries")) != len(ours):
+        raise AssertionError(
+            f"glued {g('ch3_n_repro')} reproduced summaries, package {n_ok}"
+        )
+    axis = ours[list(LACANNA_REPORTED.index).index("axis to axis")]
+    _near(g("ch3_axis_recomputed"), float(axis), "axis-to-axis rate", 1e-9)
+    printed_axis = float(LACANNA_REPORTED.rate_deg_s["axis to axis"])
+    reproduces = abs(axis / printed_axis - 1) < 0.02
+    if (values["ch3_axis_verdict"] == "reproduces") != reproduces:
+        raise AssertionError(f"axis verdict {values['ch3_axis_verdict']!r}")
+    groups = [
+        g(n)
+        for n in values
+        if n.startswith(("ch3_pair_", "ch3_ex3_t", "ch3_ex3_d", "ch3_ex3_p"))
+    ]
+    hit = any(abs(v / printed_axis - 1) < 0.02 for v in groups)
+    if (values["ch3_grouping_verdict"] == "One grouping") != hit or len(groups) < 9:
+        raise AssertionError(
+            f"grouping verdict {values['ch3_grouping_verdict']!r}, {groups}"
+        )
+    flat = LACANNA_TABLES[LACANNA_TABLES.position_deg == 0]
+    m = flat.set_index(["table", "device", "axis"]).mean_deg_s
+    _near(
+        g("ch3_prior_err_max"),
+        float((m.loc[2] - m.loc[3]).abs().max()),
+        "prior error",
+        1e-9,
+    )
+    # section 5: Allan terms listed once, found or missed
+    found, missed = values["ch3_allan_found"], values["ch3_allan_missed"]
+    if (
+        "angle random walk" not in found + missed
+        or "rate random walk" not in found + missed
+    ):
+        raise AssertionError(f"Allan lists: found {found!r}, missed {missed!r}")
+    # section 6: the magnetometer verdict follows the glued heading errors
+    better = g("ch3_head_ell") < min(g("ch3_head_four"), g("ch3_head_minmax"))
+    if (values["ch3_mag_verdict"] == "corrects") != better:
+        raise AssertionError(f"magnetometer verdict {values['ch3_mag_verdict']!r}")
+    if not g("ch3_mag_cal_max") - g("ch3_mag_cal_min") < g("ch3_mag_raw_max") - g(
+        "ch3_mag_raw_min"
+    ):
+        raise AssertionError("the calibrated norms spread more than the raw ones")
+    # section 7: the repaired pairing is no worse than the naive one
+    if not g("ch3_ttl_repaired") <= g("ch3_ttl_naive") + 1e-9:
+        raise AssertionError("TTL repair leaves larger lags than naive pairing")
+    # section 9: the saved calibration applied what the tumble calibration corrects
+    session = datasets.load("fayat:example")
+    todo = [c for c in res.calibration.corrects() if c.split("_")[0] in session]
+    if values["ch3_applied"] != ", ".join(todo):
+        raise AssertionError(f"applied {values['ch3_applied']!r}, expected {todo}")
+    printed(
+        nb_path,
+        r"same corrections as the fitted calibration: (yes)",
+        "saved/loaded match",
+    )
+    printed(nb_path, r"CalibrationError: .*changed after saving", "tamper refusal")
+    return f"{len(values)} glued values, summary statements consistent"
 
 
 VARIANTS = {"tag": prepare_tag}

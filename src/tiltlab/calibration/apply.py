@@ -11,13 +11,18 @@ or device→body from :func:`mounting_rotation`). Offsets are stored in g, °/s 
 :func:`calibrate` converts to the Recording's units. What was applied is recorded, as
 JSON, in ``attrs["calibration"]``; applying the same calibration twice, or correcting an
 already corrected quantity again, raises :class:`CalibrationError`.
+:func:`save_calibration_file` and :func:`load_calibration_file` keep a calibration in a JSON file
+(with its fingerprint, checked on loading), so that one calibration session corrects the
+recordings of later ones.
 """
 
 from __future__ import annotations
 
 import hashlib
 import json
+import os
 from dataclasses import dataclass, field, fields
+from pathlib import Path
 from typing import Any, NamedTuple
 
 import numpy as np
@@ -42,6 +47,8 @@ __all__ = [
     "Calibration",
     "calibrate",
     "applied_calibrations",
+    "save_calibration_file",
+    "load_calibration_file",
     "TumbleResult",
     "tumble_calibration",
 ]
@@ -205,6 +212,141 @@ def applied_calibrations(rec: xr.Dataset) -> list[dict]:
     if raw is None:
         return []
     return json.loads(raw) if isinstance(raw, str) else list(raw)
+
+
+_FILE_FORMAT = "tiltlab-calibration"
+_FILE_VERSION = 1
+
+
+def _checksum(d: dict[str, Any]) -> str:
+    return hashlib.sha256(json.dumps(d, sort_keys=True).encode()).hexdigest()
+
+
+def save_calibration_file(calibration: Calibration, path: str | os.PathLike) -> Path:
+    """Write a :class:`Calibration` to a JSON file that :func:`load_calibration_file` reads.
+
+    The file holds the calibration (:meth:`Calibration.to_dict`), its
+    :meth:`~Calibration.fingerprint` and a SHA-256 of the whole entry (name and info
+    included), so that a file edited after saving is refused on loading.
+
+    Parameters
+    ----------
+    calibration : Calibration
+        The calibration to save (e.g. ``tumble_calibration(rec).calibration``).
+    path : str or path-like
+        The file to write (replaced if it exists); its folder must exist.
+
+    Returns
+    -------
+    pathlib.Path
+        The file written.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> from tiltlab import calibration
+    >>> cal = calibration.Calibration(name="bench", acc_offset=[0.01, -0.02, 0.0])
+    >>> path = calibration.save_calibration_file(cal, Path(tempfile.mkdtemp()) / "imu.json")
+    >>> calibration.load_calibration_file(path) == cal
+    True
+    """
+    if not isinstance(calibration, Calibration):
+        raise TypeError(
+            "save_calibration_file writes a tiltlab.calibration.Calibration, got "
+            f"{type(calibration).__name__}"
+        )
+    path = Path(path)
+    entry = calibration.to_dict()
+    record = {
+        "format": _FILE_FORMAT,
+        "version": _FILE_VERSION,
+        "fingerprint": calibration.fingerprint(),
+        "sha256": _checksum(entry),
+        "calibration": entry,
+    }
+    path.write_text(json.dumps(record, indent=2, sort_keys=True) + "\n", "utf-8")
+    return path
+
+
+def load_calibration_file(path: str | os.PathLike) -> Calibration:
+    """Read a :class:`Calibration` written by :func:`save_calibration_file`, checking it.
+
+    Parameters
+    ----------
+    path : str or path-like
+        A file written by :func:`save_calibration_file`.
+
+    Returns
+    -------
+    Calibration
+        The saved calibration, equal to the one that was saved (same fingerprint).
+
+    Raises
+    ------
+    FileNotFoundError
+        No file at ``path``.
+    CalibrationError
+        The file is not a tiltlab calibration file (not JSON, another format or a newer
+        version, entries missing or invalid), or it was changed after saving: its
+        corrections no longer match the stored fingerprint, or its name or info no
+        longer match the stored checksum. The message names the problem.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> from tiltlab import calibration
+    >>> cal = calibration.Calibration(name="bench", gyr_offset=[1.5, -0.3, 0.2])
+    >>> path = calibration.save_calibration_file(cal, Path(tempfile.mkdtemp()) / "imu.json")
+    >>> loaded = calibration.load_calibration_file(path)
+    >>> loaded.gyr_offset, loaded.fingerprint() == cal.fingerprint()
+    ((1.5, -0.3, 0.2), True)
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise FileNotFoundError(f"no calibration file at {path}")
+    try:
+        record = json.loads(path.read_text("utf-8"))
+    except (UnicodeDecodeError, json.JSONDecodeError) as err:
+        raise CalibrationError(
+            f"{path} is not a calibration file: it is not valid JSON ({err})"
+        ) from None
+    if not isinstance(record, dict) or record.get("format") != _FILE_FORMAT:
+        raise CalibrationError(
+            f"{path} is not a calibration file: it has no 'format': {_FILE_FORMAT!r} "
+            "entry (write one with tiltlab.calibration.save_calibration_file)"
+        )
+    version = record.get("version")
+    if version != _FILE_VERSION:
+        raise CalibrationError(
+            f"{path} is a calibration file of version {version!r}; this tiltlab reads "
+            f"version {_FILE_VERSION}"
+        )
+    missing = [k for k in ("fingerprint", "sha256", "calibration") if k not in record]
+    if missing or not isinstance(record["calibration"], dict):
+        raise CalibrationError(
+            f"{path} is an incomplete calibration file: missing or invalid "
+            f"{', '.join(missing) or 'calibration'}"
+        )
+    try:
+        calibration = Calibration.from_dict(record["calibration"])
+    except (TypeError, ValueError, KeyError) as err:
+        raise CalibrationError(
+            f"{path} holds an invalid calibration entry: {err}"
+        ) from None
+    stored, computed = record["fingerprint"], calibration.fingerprint()
+    if stored != computed:
+        raise CalibrationError(
+            f"{path} was changed after saving: its corrections have fingerprint "
+            f"{computed}, the file states {stored}; refit or re-save the calibration"
+        )
+    if record["sha256"] != _checksum(record["calibration"]):
+        raise CalibrationError(
+            f"{path} was changed after saving: its name or info no longer match the "
+            "stored checksum (the corrections are unchanged); re-save the calibration"
+        )
+    return calibration
 
 
 def _temp_celsius(rec):

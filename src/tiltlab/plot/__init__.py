@@ -23,6 +23,7 @@ Submodules
 Everything is re-exported here: ``from tiltlab import plot; plot.kde_map(k)``.
 """
 
+from .calibration import mag_calibration_figure
 from .cohort import group_lines, tukey_boxplot
 from .filters import estimates_overview, plain_log_ticks, running_rms, tilt_angle_deg
 from .learning import learning_curves, method_strips
