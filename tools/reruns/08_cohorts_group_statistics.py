@@ -7,7 +7,7 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
-from ._common import printed
+from ._common import glued, glued_float, printed
 from ._foreign import foreign_cohort
 
 SMALL = {"SEED": 3, "MAP_ANIMALS": 2, "POWER_N": [3, 4, 6, 8], "N_SIM_POWER": 100}
@@ -60,6 +60,125 @@ def _design_lines(nb_path: Path) -> tuple[dict[str, int], int, int, int]:
     return groups, n_tests, n_features, n_post
 
 
+def _recomputed(params: dict):
+    """The chapter's features (from the cohort run's cache) and design, rebuilt with the
+    package from the same parameters."""
+    from tiltlab import cohort, stats
+
+    manifest = cohort.read_manifest(params["COHORT_MANIFEST"])
+    features = cohort.run_cohort(manifest, cohort.FeatureConfig(), progress=False)
+    design = stats.study_design(
+        features,
+        control=params.get("CONTROL_GROUP"),
+        baseline="auto",
+        families=params.get("FAMILIES"),
+        directions=params.get("DIRECTIONS"),
+    )
+    return features, design
+
+
+def _check_summary(nb_path: Path, params: dict) -> str:
+    """The summary's glued counts of significant cells equal those of the Tables A1–A8
+    analogues recomputed with the package; exercise 1's and exercise 2's glued answers
+    equal their recomputation; on a longitudinal design, the glued agreement between
+    the Wald and the permutation tests equals its recomputation."""
+    from tiltlab import stats
+
+    values = glued(nb_path)
+    features, design = _recomputed(params)
+    alpha = 0.05
+    counts = {"cells_between": 0, "sig_between": 0, "cells_within": 0, "sig_within": 0}
+    tables = {}
+    for feature in stats.FAYAT_FEATURE_TABLES:
+        between, within = stats.design_tables(features, feature, design)
+        tables[feature] = between
+        for name, tidy in (("between", between), ("within", within)):
+            if tidy is not None:
+                counts[f"cells_{name}"] += int(tidy["p"].notna().sum())
+                counts[f"sig_{name}"] += int((tidy["p_paper"] < alpha).sum())
+    for name, count in counts.items():
+        if int(glued_float(values, f"ch8_{name}")) != count:
+            raise AssertionError(
+                f"summary glues ch8_{name} = {values[f'ch8_{name}']}, the package "
+                f"recomputes {count}"
+            )
+    auto = stats.design_tables(features, "immobile_fraction_auto", design)[0]
+    for name, tidy in (("fixed", tables["immobile_fraction"]), ("valley", auto)):
+        n = int((tidy["p_paper"] < alpha).sum())
+        if int(glued_float(values, f"ch8_ex2_n_{name}")) != n:
+            raise AssertionError(
+                f"exercise 2 glues {name} = {values[f'ch8_ex2_n_{name}']}, recomputed {n}"
+            )
+    word = values.get("ch8_ex2_fewer", "").strip()
+    n_fixed, n_valley = (
+        int(glued_float(values, f"ch8_ex2_n_{k}")) for k in ("fixed", "valley")
+    )
+    expected = (
+        "fewer" if n_valley < n_fixed else "more" if n_valley > n_fixed else "as many"
+    )
+    if word != expected:
+        raise AssertionError(
+            f"exercise 2 says {word!r} cells, the counts say {expected!r}"
+        )
+    mw = next(
+        n for n in range(2, 30) if 18 * stats.exact_p_lattice(n, n)["p"].iloc[0] <= 0.01
+    )
+    sr = next(
+        n
+        for n in range(2, 30)
+        if 6 * stats.signed_rank_p_lattice(n)["p"].iloc[0] <= 0.01
+    )
+    if (
+        int(glued_float(values, "ch8_ex1_mw_n")),
+        int(glued_float(values, "ch8_ex1_sr_n")),
+    ) != (mw, sr):
+        raise AssertionError(
+            f"exercise 1 glues {values['ch8_ex1_mw_n']}, {values['ch8_ex1_sr_n']}; lattices give {mw}, {sr}"
+        )
+    agree = terms = 0
+    focus = params.get("FOCUS_GROUP")
+    if design.longitudinal and focus:
+        control = design.control
+        for feature in stats.FAYAT_FEATURE_TABLES:
+            long = stats.long_table(features, feature)
+            fit = stats.mixed_model(
+                long, "value", reference_group=control, baseline=design.baseline
+            )
+            pair = long[long["group"].isin([focus, control])]
+            perm = stats.permutation_interaction(
+                pair,
+                "value",
+                reference_group=control,
+                baseline=design.baseline,
+                seed=params.get("SEED", 0),
+            )
+            wald = fit.table.set_index("term").reindex(perm["term"])["p"].to_numpy()
+            ok = ~(_nonfinite(wald) | _nonfinite(perm["p"].to_numpy()))
+            terms += int(ok.sum())
+            agree += int(
+                ((wald[ok] < alpha) == (perm["p"].to_numpy()[ok] < alpha)).sum()
+            )
+        glued_pair = (
+            int(glued_float(values, "ch8_perm_terms")),
+            int(glued_float(values, "ch8_perm_agree")),
+        )
+        if glued_pair != (terms, agree):
+            raise AssertionError(
+                f"§8 glues {glued_pair[1]} of {glued_pair[0]} Wald/permutation agreements, "
+                f"recomputed {agree} of {terms}"
+            )
+    return (
+        f"glued counts match the package: {counts}; Wald/permutation agree on "
+        f"{agree} of {terms}"
+    )
+
+
+def _nonfinite(a):
+    import numpy as np
+
+    return ~np.isfinite(np.asarray(a, dtype=float))
+
+
 def check(nb_path: Path, params: dict) -> str:
     """The chapter analysed the prepared cohort (its groups and time points) and printed
     its tables: one Fayat block (lesion vs control, lesion vs sham, sham vs control)
@@ -103,7 +222,8 @@ def check(nb_path: Path, params: dict) -> str:
         )
     return (
         f"{tests} tests on {len(groups)} groups × {post} time points; "
-        f"{subject} {timepoint} circling {index} /min (package: {circling:+.3f})"
+        f"{subject} {timepoint} circling {index} /min (package: {circling:+.3f}); "
+        + _check_summary(nb_path, params)
     )
 
 
@@ -137,7 +257,10 @@ def check_foreign(nb_path: Path, params: dict) -> str:
     failed = printed(nb_path, r"left out: (.+)", "failed sessions")
     if "broken" not in failed[0]:
         raise AssertionError(f"the failed session is not listed: {failed[0]!r}")
-    return f"{groups}, one time point, {tests} tests, failed session listed"
+    return (
+        f"{groups}, one time point, {tests} tests, failed session listed; "
+        + _check_summary(nb_path, params)
+    )
 
 
 VARIANTS = {"foreign": prepare_foreign}

@@ -14,6 +14,8 @@ One implementation each:
 * :mod:`~tiltlab.stats.effects` — rank-biserial correlation, probability of
   superiority, Hodges–Lehmann shift with its exact distribution-free interval;
 * :mod:`~tiltlab.stats.mixed` — :func:`mixed_model` (MixedLM with convergence checks);
+* :mod:`~tiltlab.stats.permutation` — :func:`permutation_interaction`, the group × time
+  interaction tested by relabelling whole subjects (exact or random relabellings);
 * :mod:`~tiltlab.stats.power` — :func:`power_by_simulation`, :func:`animals_needed`
   for a user-supplied simulator (this package never imports :mod:`tiltlab.simulate`);
 * :mod:`~tiltlab.stats.design` — :func:`study_design`: groups, control, time points,
@@ -62,6 +64,7 @@ from .nonparametric import (
     signed_rank_p_lattice,
     wilcoxon_signed_rank,
 )
+from .permutation import permutation_interaction
 from .published import (
     FAYAT_DESIGN,
     FAYAT_FEATURE_TABLES,
@@ -99,6 +102,7 @@ from .effects import __all__ as _effects_all
 from .mixed import __all__ as _mixed_all
 from .multiple import __all__ as _multiple_all
 from .nonparametric import __all__ as _nonparametric_all
+from .permutation import __all__ as _permutation_all
 from .power import __all__ as _power_all
 from .published import __all__ as _published_all
 from .summaries import __all__ as _summaries_all
@@ -111,6 +115,7 @@ __all__ = [
     *_multiple_all,
     *_effects_all,
     *_mixed_all,
+    *_permutation_all,
     *_power_all,
     *_tables_all,
     *_summaries_all,
