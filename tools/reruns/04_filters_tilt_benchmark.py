@@ -4,9 +4,12 @@ NetCDF file (a lab's own recording) in place of the real rat."""
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
-from ._common import printed
+from ._common import glued, glued_float, printed
+
+_NUM = r"[-+]?[0-9.]+"
 
 
 def prepare(tmp: Path) -> dict:
@@ -31,9 +34,22 @@ def prepare(tmp: Path) -> dict:
     }
 
 
-def check(nb_path: Path, params: dict) -> str:
-    """The Madgwick error the chapter prints for ``SOURCE`` (§2) equals BROAD's inclination
-    RMSE computed directly with ``tiltlab.evaluate``."""
+def _pairs(text: str) -> dict[str, float]:
+    """``"name value, name value"`` → dict."""
+    return {
+        m: float(v) for m, v in re.findall(rf"([a-z_]+) ({_NUM})", text) if v != "."
+    }
+
+
+def _one(pattern: str, text: str, what: str) -> tuple:
+    m = re.search(pattern, text)
+    if m is None:
+        raise AssertionError(f"the glued {what} does not read as expected: {text!r}")
+    return m.groups()
+
+
+def _check_first_look(nb_path: Path, params: dict, values: dict) -> str:
+    """§2: the Madgwick error and the glued ranks of the seven filters, recomputed."""
     from tiltlab import datasets, evaluate, filters
 
     found = printed(
@@ -49,8 +65,253 @@ def check(nb_path: Path, params: dict) -> str:
             f"chapter says Madgwick RMSE {got:.3f} deg on {params['SOURCE']}, "
             f"evaluate.tilt_rmse gives {expected:.3f} deg"
         )
+    seven = [
+        "lowpass",
+        "complementary",
+        "madgwick",
+        "mahony",
+        "ekf",
+        "smoother",
+        "rts_smoother",
+    ]
+    est = {m: filters.estimate(rec, m, gaps="segments") for m in seven}
+    table = evaluate.error_summary(est, rec).sort_values("rmse")
+    rank = {m: i + 1 for i, m in enumerate(table.index)}
+    sm, rts, n, lp = _one(
+        r"smoothers rank (\d+) and (\d+) of (\d+); the low-pass tilt, which trusts the "
+        r"accelerometer alone, ranks (\d+)",
+        values["ch4_first_ranking"],
+        "ranking of §2",
+    )
+    want = (rank["smoother"], rank["rts_smoother"], len(rank), rank["lowpass"])
+    if (int(sm), int(rts), int(n), int(lp)) != want:
+        raise AssertionError(
+            f"§2 glues ranks smoother {sm}, rts_smoother {rts} of {n}, lowpass {lp}; "
+            f"evaluate.error_summary gives {want}"
+        )
     return (
-        f"Madgwick RMSE on {params['SOURCE']} {got:.3f} deg (package: {expected:.3f})"
+        f"Madgwick RMSE on {params['SOURCE']} {got:.3f} deg (package: {expected:.3f}); "
+        f"§2 ranks {want} recomputed"
+    )
+
+
+def _check_broad_summary(nb_path: Path, values: dict) -> str:
+    """§4 and the summary: the glued winners, counts and p-values against the printed
+    LOTO table and paired comparisons."""
+    loto = _pairs(printed(nb_path, r"LOTO mean \(deg\): (.*)", "LOTO means")[0])
+    optimistic = _pairs(
+        printed(nb_path, r"all-trials optimum \(deg\): (.*)", "optimistic means")[0]
+    )
+    best_name, best_val = _one(
+        rf"The lowest LOTO mean is ([a-z_]+)'s \(({_NUM}) deg\)",
+        values["ch4_sum_offline"],
+        "best LOTO method",
+    )
+    argmin = min(loto, key=loto.get)
+    if best_name != argmin or abs(float(best_val) - loto[argmin]) > 0.0006:
+        raise AssertionError(
+            f"summary says the lowest LOTO mean is {best_name}'s ({best_val}); the "
+            f"printed LOTO means give {argmin} ({loto[argmin]:.4f})"
+        )
+    offline = ["offline_vqf", "smoother", "rts_smoother"]
+    causal = [
+        m
+        for m in ("complementary", "madgwick", "mahony", "ekf", "vqf", "imufusion")
+        if m in loto
+    ]
+    worst, verdict, best_c = _one(
+        r"worst ([a-z_]+), .* is (more|not more) accurate than every causal filter "
+        r"\(best ([a-z_]+),",
+        values["ch4_sum_offline"],
+        "offline-versus-causal statement",
+    )
+    w, c = max(offline, key=loto.get), min(causal, key=loto.get)
+    ahead = "more" if loto[w] < loto[c] else "not more"
+    if (worst, best_c, verdict) != (w, c, ahead):
+        raise AssertionError(
+            f"summary: worst offline {worst}, best causal {best_c}, '{verdict}'; printed "
+            f"LOTO means give {w}, {c}, '{ahead}'"
+        )
+    n_used = len(
+        printed(
+            nb_path,
+            r"undisturbed trials used here: \d+ of BROAD's \d+ \(([^)]*)\)",
+            "trials",
+        )[0].split(", ")
+    )
+    n_said = int(
+        printed(nb_path, r"undisturbed trials used here: (\d+) of", "trial count")[0]
+    )
+    if n_used != n_said:
+        raise AssertionError(f"§4 prints {n_said} trials but lists {n_used}")
+    for m in ("rts_smoother", "smoother"):
+        diff, low, n, p = printed(
+            nb_path,
+            rf"(?<![a-z_]){m} - offlineVQF \(LOTO\): ({_NUM}) deg; lower on (\d+) of (\d+) trials "
+            rf"\(paired Wilcoxon p = ([0-9.]+)\)",
+            f"{m} comparison",
+        )[0]
+        g = values[f"ch4_sum_{'rts' if m == 'rts_smoother' else 'smoother'}"]
+        gd, gl, gn, gp, sig = _one(
+            rf"by ({_NUM}) deg .* lower on (\d+) of (\d+) trials \(paired Wilcoxon p = "
+            r"([0-9.]+), (significant|not significant)",
+            g,
+            f"{m} summary",
+        )
+        if (gd, gl, gn, gp) != (diff, low, n, p) or int(n) != n_used:
+            raise AssertionError(f"summary {g!r} disagrees with the printed {m} line")
+        if (sig == "significant") != (float(p) < 0.05):
+            raise AssertionError(f"summary calls p = {p} {sig}")
+        if abs(float(diff) - (loto[m] - loto["offline_vqf"])) > 0.00051:
+            raise AssertionError(
+                f"{m} - offlineVQF = {diff} deg, the printed LOTO means give "
+                f"{loto[m] - loto['offline_vqf']:+.4f}"
+            )
+    stable_line = printed(nb_path, r"same choice in every fold: (.*)", "stable methods")
+    stable = [s for s in stable_line[0].split(", ") if s != "none"]
+    gap = {m: loto[m] - optimistic[m] for m in loto}
+    text = values["ch4_sum_loto"]
+    if stable:
+        (got,) = _one(r"by at most ([0-9.]+) deg for the", text, "stable LOTO gap")
+        if abs(float(got) - max(gap[m] for m in stable)) > 0.0011:
+            raise AssertionError(f"summary {text!r}: stable methods' gap is wrong")
+    unstable = [m for m in gap if m not in stable]
+    if unstable:
+        got, who = _one(r"by up to ([0-9.]+) deg \(([a-z_]+)\)", text, "LOTO gap")
+        top = max(unstable, key=gap.get)
+        if who != top or abs(float(got) - gap[top]) > 0.011:
+            raise AssertionError(
+                f"summary says LOTO exceeds the optimum by up to {got} ({who}); printed "
+                f"means give {gap[top]:.3f} ({top})"
+            )
+    return f"summary: best LOTO {argmin}, offline vs causal '{ahead}', {n_used} trials"
+
+
+def _check_simulation(nb_path: Path, values: dict) -> str:
+    """§5: the crossover, the offset reductions and Table 1's shape against the printed
+    lines; the glued session count against the sessions kept."""
+    bins = printed(
+        nb_path,
+        r"bins \(deg/s\) where the EKF's median error is below Madgwick's: (.*)",
+        "crossover bins",
+    )[0]
+    lows = [] if bins == "none" else [float(b.split("–")[0]) for b in bins.split(", ")]
+    high = {100.0, 150.0, 200.0, 300.0}  # the chapter's bins from 100 deg/s up
+    n_high = len(high & set(lows))
+    phrase = (
+        "does not reproduce"
+        if n_high == 0
+        else ("reproduces their crossover:" if n_high == len(high) else "only in part")
+    )
+    if phrase not in values["ch4_crossover"]:
+        raise AssertionError(
+            f"§5.3 glues {values['ch4_crossover']!r} but prints bins {bins!r}"
+        )
+    red = _pairs(
+        printed(
+            nb_path,
+            r"reduction of the optimal error by offset correction:\n(.*)",
+            "reductions",
+        )[0]
+    )
+    larger = [s for s, v in (("moving", 27.0), ("immobile", 45.0)) if red[s] > v]
+    want = (
+        "larger than theirs in both"
+        if len(larger) == 2
+        else (
+            "smaller than theirs in both" if not larger else f"only for the {larger[0]}"
+        )
+    )
+    if want not in values["ch4_offset_comparison"]:
+        raise AssertionError(
+            f"§5.4 glues {values['ch4_offset_comparison']!r}; printed reductions {red}"
+        )
+    ours = _pairs(printed(nb_path, r"  ours:  (.*)", "movement errors")[0])
+    fayat = _pairs(printed(nb_path, r"  Fayat: (.*)", "Fayat's movement errors")[0])
+    lp_worst = max(ours, key=ours.get) == "lowpass"
+    same = lp_worst == (max(fayat, key=fayat.get) == "lowpass")
+    want = (
+        f"{'has' if lp_worst else 'does not have'} the largest mean error during movement "
+        f"({'as' if same else 'unlike'} in their Table 1)"
+    )
+    if want not in values["ch4_sum_sim"]:
+        raise AssertionError(f"summary {values['ch4_sum_sim']!r}: expected {want!r}")
+    kept = int(printed(nb_path, r"(\d+) of \d+ simulated sessions", "sessions kept")[0])
+    rows = printed(nb_path, r"sessions per row: (\d+)", "sessions per row")
+    if int(glued_float(values, "ch4_n_sim")) != kept or int(rows[0]) != kept:
+        raise AssertionError(f"{kept} sessions kept, glued {values['ch4_n_sim']}")
+    return f"crossover '{phrase}', offset reductions {red}, {kept} sessions"
+
+
+def _check_rat(nb_path: Path, params: dict, values: dict) -> str:
+    """§6 and the summary: the immobile fractions glued equal ``behavior.immobility``."""
+    from tiltlab import behavior, calibration, datasets
+
+    rat = datasets.load(params["RAT_SOURCE"])
+    text = values["ch4_sum_immobility"]
+    if "gyr" not in rat:
+        (got,) = _one(r"\(([0-9.]+)% immobile\)", text, "tag immobility")
+        want = 100 * float(behavior.immobility(rat).mean())
+        if (
+            "no gyroscope" not in values["ch4_rat_agreement"]
+            or abs(float(got) - want) > 0.051
+        ):
+            raise AssertionError(f"summary {text!r}; behavior.immobility {want:.1f} %")
+        return f"tag: {got} % immobile (package {want:.1f} %)"
+    off = calibration.robust_gyro_offset(rat)
+    fixed = behavior.immobility(rat, threshold_deg_s=12.0, gyr_offset=off)
+    auto = behavior.immobility(rat, threshold_deg_s="auto", gyr_offset=off)
+    agree, f12, fa = _one(
+        r"class ([0-9.]+)% of the samples alike \(([0-9.]+)% and ([0-9.]+)% immobile",
+        text,
+        "immobility agreement",
+    )
+    want = [
+        100 * float((fixed == auto).mean()),
+        100 * float(fixed.mean()),
+        100 * float(auto.mean()),
+    ]
+    if any(abs(float(g) - w) > 0.051 for g, w in zip((agree, f12, fa), want)):
+        raise AssertionError(f"summary {text!r}; behavior.immobility gives {want}")
+    return f"rat: thresholds agree on {agree} % (package {want[0]:.1f} %)"
+
+
+def _check_exercises(nb_path: Path, values: dict) -> str:
+    """Exercise 2: the glued fold count equals the printed choices of the folds."""
+    counts = printed(
+        nb_path, r"gains chosen without each trial: \{(.*)\}", "fold choices"
+    )[0]
+    chosen = {float(k): int(v) for k, v in re.findall(r"([0-9.e-]+): (\d+)", counts)}
+    opt = float(
+        printed(
+            nb_path, r"all-trials optimum [0-9.]+ deg at beta = ([0-9.e-]+)", "optimum"
+        )[0]
+    )
+    n_opt, n = _one(
+        r"(\d+) of (\d+) folds", values["ch4_ex2_folds"], "exercise 2 folds"
+    )
+    if (int(n_opt), int(n)) != (chosen.get(opt, 0), sum(chosen.values())):
+        raise AssertionError(
+            f"exercise 2 glues {n_opt} of {n}; printed choices {chosen}"
+        )
+    return f"exercise 2: {n_opt} of {n} folds at the optimum"
+
+
+def check(nb_path: Path, params: dict) -> str:
+    """The chapter's glued statements agree with the tables and lines they summarise,
+    and the values recomputed with the package: §2's Madgwick error and ranks, the
+    summary's LOTO winner, offline-versus-causal verdict, paired comparisons and LOTO
+    gaps, §5's crossover, offset reductions and Table 1 shape, the immobility
+    agreement, and exercise 2's fold count."""
+    values = glued(nb_path)
+    return "; ".join(
+        [
+            _check_first_look(nb_path, params, values),
+            _check_broad_summary(nb_path, values),
+            _check_simulation(nb_path, values),
+            _check_rat(nb_path, params, values),
+            _check_exercises(nb_path, values),
+        ]
     )
 
 
@@ -64,8 +325,9 @@ def prepare_tag(tmp: Path) -> dict:
 
 
 def check_tag(nb_path: Path, params: dict) -> str:
-    """The immobile fraction the chapter prints for the tag (§6, summary) equals
-    ``behavior.immobility`` (the accelerometer rule) on the converted file."""
+    """The immobile fraction the chapter prints and glues for the tag (§6, summary)
+    equals ``behavior.immobility`` (the accelerometer rule) on the converted file, and
+    the BROAD and simulation statements still agree with their tables."""
     from tiltlab import behavior, datasets
 
     rat = datasets.load(params["RAT_SOURCE"])
@@ -83,7 +345,15 @@ def check_tag(nb_path: Path, params: dict) -> str:
         raise AssertionError(
             f"chapter says {got:.1f} % immobile, behavior.immobility gives {expected:.1f} %"
         )
-    return f"tag immobile {got:.1f} % by the accelerometer rule (package: {expected:.1f} %)"
+    values = glued(nb_path)
+    return "; ".join(
+        [
+            f"tag immobile {got:.1f} % by the accelerometer rule (package: {expected:.1f} %)",
+            _check_rat(nb_path, params, values),
+            _check_broad_summary(nb_path, values),
+            _check_simulation(nb_path, values),
+        ]
+    )
 
 
 VARIANTS = {"tag": prepare_tag}
