@@ -185,7 +185,9 @@ def eskf(
     **Injection and reset** after each sensor's update:
     :math:`q \leftarrow \mathrm{Exp}(\delta\theta) \otimes q`,
     :math:`b \leftarrow b + \delta b`, :math:`\delta x \leftarrow 0`; the reset Jacobian
-    :math:`G = I - [\tfrac12 \delta\theta]_\times` is taken as :math:`I` (first order).
+    of this global (left-multiplied) error, :math:`G = I + [\tfrac12 \delta\theta]_\times`
+    (the local error of Solà's text has the opposite sign), is taken as :math:`I` (first
+    order).
 
     Initial covariance :math:`P_0 = \mathrm{diag}(\sigma_{tilt}^2, \sigma_{tilt}^2,
     \sigma_{head}^2, \sigma_{b0}^2 I_3)` (:math:`\sigma_{head} = 0` in 6D). In 6D the
