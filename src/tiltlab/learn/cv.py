@@ -46,6 +46,7 @@ __all__ = [
     "ablate",
     "folds",
     "cross_validate",
+    "validation_split",
     "check_files",
     "trial_errors",
     "learned_estimate",
@@ -145,6 +146,39 @@ def trial_errors(q, rec) -> dict[str, float]:
     }
 
 
+def validation_split(train_trials: Iterable[int], n: int) -> list[int]:
+    """Pick ``n`` validation trials, evenly spread, from a fold's training trials.
+
+    Parameters
+    ----------
+    train_trials : iterable of int
+        The fold's training trials.
+    n : int
+        How many to keep out for validation (0: none).
+
+    Returns
+    -------
+    list of int
+        Sorted validation trials; the same for the same inputs.
+
+    Examples
+    --------
+    >>> validation_split([1, 2, 3, 4, 5, 6, 7, 8], 2)
+    [1, 5]
+    """
+    pool = sorted(int(t) for t in train_trials)
+    n = int(_v.integer(n, "n", minimum=0))
+    if n >= len(pool) and n:
+        raise ValueError(
+            f"cannot keep {n} of {len(pool)} training trials for validation: at "
+            "least one must remain for training"
+        )
+    if n == 0:
+        return []
+    step = len(pool) / n
+    return sorted(pool[int(i * step)] for i in range(n))
+
+
 def cross_validate(
     out: str | Path,
     *,
@@ -152,6 +186,7 @@ def cross_validate(
     n_folds: int = 5,
     variants: Seq[str] = ("quaternion", "gain"),
     config: TrainConfig | None = None,
+    n_validation: int = 0,
     command: str = "",
     progress: Callable[[str], None] = print,
 ) -> pd.DataFrame:
@@ -172,6 +207,12 @@ def cross_validate(
         Model variants (``TrainConfig.variant``) to train.
     config : TrainConfig, optional
         Base configuration, default ``TrainConfig()``; ``variant`` is set per variant.
+    n_validation : int, default 0
+        Training trials of each fold kept out of its training for validation
+        (:func:`validation_split`): the weights of the epoch with the lowest
+        closed-loop validation error are kept, and training stops early after
+        ``config.patience`` epochs without improvement. 0 trains on every training
+        trial for ``config.epochs`` epochs.
     command : str, default ""
         Command line recorded in the output files.
     progress : callable, default print
@@ -197,14 +238,24 @@ def cross_validate(
     history: dict[str, Any] = {}
     rows: list[dict[str, Any]] = []
     configs = {}
+    n_validation = int(_v.integer(n_validation, "n_validation", minimum=0))
+    held = {
+        k: validation_split([t for t in trials if t not in test], n_validation)
+        for k, test in enumerate(fold_list)
+    }
     for variant in variants:
         cfg = TrainConfig.from_dict({**base.to_dict(), "variant": variant})
         configs[variant] = cfg.to_dict()
         for k, test in enumerate(fold_list):
-            train_set = [seqs[t] for t in trials if t not in test]
+            train_set = [seqs[t] for t in trials if t not in test and t not in held[k]]
             progress(f"{variant}, fold {k + 1}/{len(fold_list)}: test trials {test}")
             t0 = time.perf_counter()
-            model, hist = train(train_set, cfg, progress=progress)
+            model, hist = train(
+                train_set,
+                cfg,
+                validation=[seqs[t] for t in held[k]],
+                progress=progress,
+            )
             history[f"{variant}/fold{k}"] = hist
             save(model, cfg, train_set[0].fs, out / f"{variant}_fold{k}.pt")
             for t in test:
@@ -220,6 +271,11 @@ def cross_validate(
             "command": command,
             "configs": configs,
             "folds": fold_list,
+            **(
+                {"validation": [held[k] for k in range(len(fold_list))]}
+                if n_validation
+                else {}
+            ),
             "trials": list(trials),
             "versions": {
                 "python": platform.python_version(),

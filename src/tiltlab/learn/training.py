@@ -21,6 +21,7 @@ Augmentations (Zaheer et al. 2023, "Data augmentation"), drawn per window:
 
 from __future__ import annotations
 
+import copy
 import dataclasses
 import hashlib
 import json
@@ -50,6 +51,7 @@ __all__ = [
     "TrainConfig",
     "build_model",
     "train",
+    "validation_error",
     "closed_loop_estimate",
     "run",
     "save",
@@ -67,6 +69,9 @@ class TrainConfig:
 
     ``window_s`` is converted to a window of ``round(window_s * fs)`` samples: the
     paper's 32 samples at 250 Hz are 0.128 s, i.e. 37 samples at BROAD's 285.7 Hz.
+    ``patience`` (epochs) stops training early once the validation error has not
+    improved for that many epochs (0: train every epoch); it needs validation
+    sequences (:func:`train`).
     """
 
     variant: str = "quaternion"
@@ -93,6 +98,7 @@ class TrainConfig:
     mount_deg: float = 10.0
     seed: int = 0
     threads: int = 1
+    patience: int = 0
 
     def __post_init__(self):
         """Check every field."""
@@ -118,6 +124,7 @@ class TrainConfig:
         for name in ("channels", "kernel", "epochs", "batch", "stride", "threads"):
             _v.integer(getattr(self, name), name, minimum=1)
         _v.integer(self.seed, "seed", minimum=0)
+        _v.integer(self.patience, "patience", minimum=0)
         object.__setattr__(self, "dilations", tuple(int(d) for d in self.dilations))
         object.__setattr__(self, "activations", tuple(self.activations))
 
@@ -279,19 +286,64 @@ def _seed(cfg: TrainConfig) -> torch.Generator:
     return g
 
 
+def validation_error(
+    model: OrientationCNN, sequences: Seq[Sequence], config: TrainConfig
+) -> float:
+    """Mean closed-loop QAE (degrees) of ``model`` over validation ``sequences``.
+
+    Each sequence is estimated in closed loop (:func:`closed_loop_estimate`), as the
+    held-out trials are, and the QAE is averaged over all samples with a reference.
+
+    Parameters
+    ----------
+    model : OrientationCNN
+        The network being trained.
+    sequences : sequence of Sequence
+        Validation data, each with ``q_ref``.
+    config : TrainConfig
+        The model's configuration (its window).
+
+    Returns
+    -------
+    float
+        Mean QAE (deg) over every sample with a finite reference.
+    """
+    total, count = 0.0, 0
+    for seq in sequences:
+        q = torch.from_numpy(closed_loop_estimate(model, seq, config))
+        ref = torch.from_numpy(np.asarray(seq.q_ref, dtype=np.float64))
+        ok = torch.isfinite(ref).all(-1)
+        err = qae(ref[ok], q[ok])
+        total += float(err.sum())
+        count += int(ok.sum())
+    if count == 0:
+        raise ValueError("no validation sample has a reference orientation")
+    return math.degrees(total / count)
+
+
 def train(
     sequences: Seq[Sequence],
     config: TrainConfig,
     *,
+    validation: Seq[Sequence] | None = None,
     max_steps: int | None = None,
     progress: Callable[[str], None] | None = None,
 ) -> tuple[OrientationCNN, list[dict[str, float]]]:
     """Train a model on ``sequences`` (each with ``q_ref``).
 
+    With ``validation`` sequences, the closed-loop validation error
+    (:func:`validation_error`) is measured after every epoch, the weights of the best
+    epoch are returned, and with ``config.patience`` > 0 training stops once that
+    many epochs have passed without improvement (early stopping). The validation
+    pass draws no random numbers, so the training steps are the same with or without
+    it.
+
     Parameters
     ----------
     sequences : sequence of Sequence
         Training data (:func:`tiltlab.learn.sequence`), all at the same ``fs``.
+    validation : sequence of Sequence, optional
+        Validation data (trials kept out of ``sequences``), same ``fs``.
     config : TrainConfig
         Model and training settings: the architecture and window (``window_s``, s),
         ``epochs``, ``batch``, ``stride``, ``lr`` and Lookahead settings, the loss, the
@@ -307,13 +359,21 @@ def train(
         In evaluation mode.
     history : list of dict
         Per epoch: ``epoch``, ``loss`` (mean total loss per batch), ``qae_deg`` (mean
-        QAE of the training windows, degrees), ``seconds``.
+        QAE of the training windows, degrees), ``seconds``; with ``validation`` also
+        ``val_qae_deg`` (closed-loop validation QAE, degrees) and ``best`` (whether
+        this epoch's weights are the ones returned so far).
     """
     if not sequences:
         raise ValueError("sequences is empty")
     fs = sequences[0].fs
-    if any(abs(s.fs - fs) > 1e-9 * fs for s in sequences):
-        raise ValueError("all training sequences must have the same fs")
+    validation = list(validation or [])
+    if any(abs(s.fs - fs) > 1e-9 * fs for s in [*sequences, *validation]):
+        raise ValueError("all training and validation sequences must have the same fs")
+    if config.patience and not validation:
+        raise ValueError(
+            f"patience = {config.patience} epochs needs validation sequences to "
+            "decide when to stop (pass validation=[...])"
+        )
     g = _seed(config)
     window = config.window(fs)
     stack = _Stack(sequences, window, config.stride)
@@ -328,6 +388,7 @@ def train(
     )
     history: list[dict[str, float]] = []
     steps = 0
+    best: tuple[float, int, dict] | None = None  # (error, epoch, weights)
     for epoch in range(config.epochs):
         model.train()
         t0 = time.perf_counter()
@@ -356,14 +417,25 @@ def train(
                 "seconds": time.perf_counter() - t0,
             }
         )
+        if validation:
+            err = validation_error(model, validation, config)
+            improved = best is None or err < best[0]
+            if improved:
+                best = (err, epoch, copy.deepcopy(model.state_dict()))
+            history[-1] |= {"val_qae_deg": err, "best": improved}
         if progress is not None:
             h = history[-1]
+            val = f", validation {h['val_qae_deg']:.2f} deg" if validation else ""
             progress(
                 f"epoch {epoch + 1}/{config.epochs}: loss {h['loss']:.4g}, "
-                f"QAE {h['qae_deg']:.2f} deg, {h['seconds']:.0f} s"
+                f"QAE {h['qae_deg']:.2f} deg{val}, {h['seconds']:.0f} s"
             )
         if max_steps is not None and steps >= max_steps:
             break
+        if best is not None and config.patience and epoch - best[1] >= config.patience:
+            break
+    if best is not None:
+        model.load_state_dict(best[2])
     model.eval()
     return model, history
 
