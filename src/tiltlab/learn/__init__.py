@@ -42,10 +42,12 @@ from .training import load, run  # the old names, for one release
 from .published import ZAHEER_TABLE2, ZAHEER_TABLE3
 from .cv import BASELINES, ERROR_COLUMNS, check_files, compare, compare_summary
 from .cv import cross_validate, folds, learned_estimate
+from .baselines import BASELINE_GRIDS, PARAMS_FILE, TUNED_BASELINES, load_tuned
+from .baselines import save_tuned, tune_baselines, tuned_compare, tuned_summary
 from .tables import config_table, layer_settings, layer_table
 
 # every public name of data, model, optim, training, published and tables; of
-# losses and cv, those listed here
+# losses, cv and baselines, those listed here
 __all__ = [
     *_data.__all__,
     "LOSSES",
@@ -64,6 +66,14 @@ __all__ = [
     "cross_validate",
     "folds",
     "learned_estimate",
+    "BASELINE_GRIDS",
+    "PARAMS_FILE",
+    "TUNED_BASELINES",
+    "load_tuned",
+    "save_tuned",
+    "tune_baselines",
+    "tuned_compare",
+    "tuned_summary",
     *_published.__all__,
     *_tables.__all__,
 ]

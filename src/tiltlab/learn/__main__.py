@@ -7,10 +7,12 @@ Examples
 --------
 ::
 
-    python -m tiltlab.learn train --out data/learn            # the committed models
+    python -m tiltlab.learn train --out data/learn --epochs 40 --stride 32 \
+        --validation 4 --patience 5 --threads 1               # the committed models
     python -m tiltlab.learn train --out /tmp/quick --epochs 1 --trials 1 2 24 25
     python -m tiltlab.learn ablate --out data/learn           # Tables 2-3 in small
     python -m tiltlab.learn check data/learn                  # verify SHA256SUMS
+    python -m tiltlab.learn tune-baselines --out data/learn_baselines  # the filters
 """
 
 from __future__ import annotations
@@ -20,6 +22,7 @@ import shlex
 import sys
 from collections.abc import Sequence
 
+from .baselines import save_tuned, tune_baselines
 from .cv import ablate, check_files, cross_validate
 from .training import TrainConfig
 
@@ -47,8 +50,22 @@ def main(argv: Sequence[str] | None = None) -> int:
         "--variants", nargs="*", default=["quaternion", "gain"], help="model variants"
     )
     defaults = TrainConfig()
-    for name in ("epochs", "batch", "stride", "channels", "seed", "threads"):
+    for name in (
+        "epochs",
+        "batch",
+        "stride",
+        "channels",
+        "seed",
+        "threads",
+        "patience",
+    ):
         t.add_argument(f"--{name}", type=int, default=getattr(defaults, name))
+    t.add_argument(
+        "--validation",
+        type=int,
+        default=0,
+        help="training trials per fold kept for validation and early stopping",
+    )
     t.add_argument("--lr", type=float, default=defaults.lr)
     t.add_argument("--loss", default=defaults.loss)
     t.add_argument("--total", default=defaults.total)
@@ -63,6 +80,14 @@ def main(argv: Sequence[str] | None = None) -> int:
     a.add_argument("--threads", type=int, default=defaults.threads)
     c = sub.add_parser("check", help="verify the files listed in SHA256SUMS")
     c.add_argument("folder")
+    b = sub.add_parser(
+        "tune-baselines", help="tune the filter baselines on the networks' folds"
+    )
+    b.add_argument("--out", required=True, help="output folder")
+    b.add_argument(
+        "--learn", default="data/learn", help="folder of the networks (its run.json)"
+    )
+    b.add_argument("--jobs", type=int, default=1, help="threads of the grid search")
     args = p.parse_args(argv)
     try:
         if args.cmd == "check":
@@ -72,6 +97,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         argv_list = list(sys.argv[1:] if argv is None else argv)
         command = "python -m tiltlab.learn " + shlex.join(argv_list)
         progress = lambda s: print(s, file=sys.stderr, flush=True)  # noqa: E731
+        if args.cmd == "tune-baselines":
+            return _tune_baselines(args.out, args.learn, args.jobs, command)
         if args.cmd == "ablate":
             table = ablate(
                 args.out,
@@ -91,6 +118,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             channels=args.channels,
             seed=args.seed,
             threads=args.threads,
+            patience=args.patience,
             lr=args.lr,
             loss=args.loss,
             total=args.total,
@@ -102,6 +130,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             n_folds=args.folds,
             variants=args.variants,
             config=cfg,
+            n_validation=args.validation,
             command=command,
             progress=progress,
         )
@@ -110,6 +139,22 @@ def main(argv: Sequence[str] | None = None) -> int:
         return 1
     summary = table.groupby("variant")[["qae_mean", "inclination", "total"]].mean()
     print(summary.round(2).to_string())
+    return 0
+
+
+def _tune_baselines(out: str, learn: str, jobs: int, command: str) -> int:
+    """Tune the baselines on the folds of ``learn/run.json`` and write ``out``."""
+    import json
+    import time
+    from pathlib import Path
+
+    check_files(learn)
+    folds = json.loads((Path(learn) / "run.json").read_text())["folds"]
+    t0 = time.perf_counter()
+    table = tune_baselines(folds, n_jobs=jobs, progress=True)
+    path = save_tuned(table, out, command=command)
+    print(table[["method", "fold", "parameters", "train_inclination"]].to_string())
+    print(f"{path} written in {time.perf_counter() - t0:.0f} s", file=sys.stderr)
     return 0
 
 
