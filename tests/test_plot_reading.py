@@ -85,3 +85,28 @@ def test_simulated_reference_names_its_axes():
     assert tilt.attrs["axis_labels"][0].startswith("forward")
     ax = plot.tilt_trace(tilt)
     assert "nose (+x)" in ax.get_ylabel()
+
+
+def _history(with_val: bool):
+    def rows(offset):
+        out = []
+        for e, (tr, va) in enumerate(zip([5.0, 4.0, 3.5, 3.4], [9.0, 7.0, 7.5, 8.0])):
+            r = {"epoch": e + 1, "qae_deg": tr + offset, "loss": 1.0}
+            if with_val:
+                r |= {"val_qae_deg": va + offset, "best": False}
+            out.append(r)
+        return out
+
+    return {f"{v}/fold{k}": rows(k) for v in ("gain", "quaternion") for k in range(2)}
+
+
+def test_learning_curves_show_validation_and_the_kept_epoch():
+    fig = plot.learning_curves(_history(True))
+    assert len(fig.axes) == 4  # training and validation rows, one column per variant
+    val_ax = fig.axes[2]
+    assert "validation" in val_ax.get_ylabel()
+    stars = [ln for ln in val_ax.get_lines() if ln.get_marker() == "*"]
+    assert len(stars) == 2  # one per fold
+    assert all(list(s.get_xdata()) == [2] for s in stars)  # the lowest validation QAE
+    plain = plot.learning_curves(_history(False))
+    assert len(plain.axes) == 2 and "training" in plain.axes[0].get_ylabel()

@@ -22,9 +22,13 @@ def learning_curves(
     history: Mapping[str, Sequence[Mapping[str, float]]],
     *,
     key: str = "qae_deg",
-    figsize=(8.4, 3.2),
+    figsize=None,
 ):
     """Training curves: ``key`` per epoch, one line per fold, one panel per variant.
+
+    When the history has a validation error (``val_qae_deg``, written by training with
+    validation trials), a second row of panels shows it, with the epoch whose weights
+    were kept (the lowest validation error) marked by a star.
 
     Parameters
     ----------
@@ -32,32 +36,55 @@ def learning_curves(
         ``"<variant>/fold<k>" -> [{"epoch": ..., key: ...}, ...]`` (``history.json``).
     key : str
         ``"qae_deg"`` (mean QAE of the training windows, degrees) or ``"loss"``.
-    figsize : (float, float)
-        Figure size in inches (default: the book's column width).
+    figsize : (float, float), optional
+        Figure size in inches (default: the book's column width, 3.2 in per row).
 
     Returns
     -------
     matplotlib.figure.Figure
     """
     variants = sorted({name.split("/")[0] for name in history})
+    with_val = any("val_qae_deg" in r for rows in history.values() for r in rows)
+    n_rows = 2 if with_val else 1
     fig, axes = plt.subplots(
-        1, len(variants), figsize=figsize, sharey=True, squeeze=False
+        n_rows,
+        len(variants),
+        figsize=figsize or (8.4, 3.2 * n_rows),
+        sharey="row",
+        sharex=True,
+        squeeze=False,
     )
-    for ax, variant in zip(axes[0], variants, strict=True):
-        for name, rows in sorted(history.items()):
+    for col, variant in enumerate(variants):
+        for k, (name, rows) in enumerate(sorted(history.items())):
             if name.split("/")[0] != variant:
                 continue
             epochs = [r["epoch"] for r in rows]
-            ax.plot(
-                epochs, [r[key] for r in rows], marker="o", label=name.split("/")[1]
+            colour = f"C{k % 10}"
+            axes[0, col].plot(
+                epochs,
+                [r[key] for r in rows],
+                marker="o",
+                ms=3,
+                color=colour,
+                label=name.split("/")[1],
             )
-        ax.set_title(variant)
-        ax.set_xlabel("epoch")
-        ax.xaxis.set_major_locator(MaxNLocator(integer=True))
-        ax.legend(title="model", fontsize=8, frameon=False)
+            if with_val:
+                val = [r.get("val_qae_deg", np.nan) for r in rows]
+                axes[1, col].plot(epochs, val, marker="o", ms=3, color=colour)
+                if np.isfinite(val).any():
+                    best = int(np.nanargmin(val))
+                    axes[1, col].plot(
+                        epochs[best], val[best], marker="*", ms=12, color=colour
+                    )
+        axes[0, col].set_title(variant)
+        axes[-1, col].set_xlabel("epoch")
+        axes[-1, col].xaxis.set_major_locator(MaxNLocator(integer=True))
+        axes[0, col].legend(title="model", fontsize=8, frameon=False, ncols=2)
     axes[0, 0].set_ylabel(
         label("training QAE", "deg") if key == "qae_deg" else "training loss"
     )
+    if with_val:
+        axes[1, 0].set_ylabel(label("validation QAE\n(closed loop)", "deg"))
     fig.tight_layout()
     return fig
 
