@@ -405,6 +405,7 @@ def test_estimate_converts_units_and_records_params(method):
 
 ALL_METHODS = {
     "lowpass",
+    "learned_gain",
     "davenport",
     "complementary",
     "madgwick",

@@ -189,11 +189,22 @@ def _check_training(values: dict[str, str]) -> None:
 
     history = json.loads((MODELS / "history.json").read_text())
     run = json.loads((MODELS / "run.json").read_text())
-    drops = [h[-2]["qae_deg"] - h[-1]["qae_deg"] for h in history.values()]
-    n_falling = sum(d > 0 for d in drops)
+    budget = run_epochs(run)
+    stopped = sum(len(h) < budget for h in history.values())
     state = _words(values, "ch5_curves_state")
-    if (state == "still falling in every model") != (n_falling == len(drops)):
-        raise AssertionError(f"glued curve state {state!r}: {n_falling} falling")
+    expected = (
+        "stopped early in every model"
+        if stopped == len(history)
+        else f"stopped early in {stopped} of {len(history)} models"
+    )
+    if state != expected:
+        raise AssertionError(f"glued curve state {state!r}, history gives {expected!r}")
+    longer = _words(values, "ch5_longer")
+    if ("no sign that a longer budget" in longer) != (stopped == len(history)):
+        raise AssertionError(f"glued longer-training sentence {longer!r} vs {expected}")
+    held = run.get("validation", [[] for _ in run["folds"]])
+    if int(glued_float(values, "ch5_n_val")) != len(held[0]):
+        raise AssertionError("glued number of validation trials differs from run.json")
     if int(glued_float(values, "ch5_epochs")) != run_epochs(run):
         raise AssertionError("glued epochs differ from the committed configuration")
     cov = datasets.broad_coverage()

@@ -30,6 +30,10 @@ Methods
 ``mahony``
     Explicit complementary filter with proportional and integral (gyro bias) terms
     (Mahony 2008).
+``learned_gain``
+    Mahony's filter (6D) whose gains a tiny learned model schedules from short windows
+    of the sensors (:mod:`~tiltlab.filters.learned_gain`; weights trained by
+    :mod:`tiltlab.learn.gain_schedule`).
 ``ekf``
     Quaternion-state extended Kalman filter with the gravity (and magnetic field)
     direction as measurement (the formulation of the ``ahrs`` package).
@@ -202,6 +206,7 @@ from .complementary import complementary
 from .ekf import EkfTuning, ekf
 from .eskf import EskfTuning, eskf
 from .lowpass import lowpass_tilt
+from .learned_gain import GainWeights, learned_gain, load_gain_weights
 from .madgwick import madgwick, madgwick_batch
 from .mahony import mahony
 from .recordings import (
@@ -252,6 +257,9 @@ __all__ = [
     "madgwick",
     "madgwick_batch",
     "mahony",
+    "learned_gain",
+    "GainWeights",
+    "load_gain_weights",
     "ekf",
     "EkfTuning",
     "eskf",

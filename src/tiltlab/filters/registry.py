@@ -45,6 +45,7 @@ from .complementary import complementary
 from .ekf import ekf
 from .eskf import eskf
 from .lowpass import lowpass_tilt
+from .learned_gain import learned_gain
 from .madgwick import madgwick
 from .mahony import mahony
 from .rts import rts_smoother
@@ -358,6 +359,12 @@ METHODS: Mapping[str, Method] = _registry(
         mahony,
         "causal",
         "Mahony's explicit complementary filter with gyro-bias integral",
+    ),
+    Method(
+        "learned_gain",
+        learned_gain,
+        "causal",
+        "Mahony (6D) with gains scheduled by a learned model (pass weights=path)",
     ),
     Method("ekf", ekf, "causal", "quaternion-state EKF (ahrs formulation)"),
     Method(

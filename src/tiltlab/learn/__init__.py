@@ -37,13 +37,16 @@ from .losses import LOSSES, TOTALS, qae, sample_loss, total_loss
 from .model import ACTIVATIONS, OrientationCNN
 from .optim import Lookahead, radam_lookahead
 from .training import SUMS_FILE, TrainConfig, build_model, closed_loop_estimate
-from .training import load_model, read_sums, save, sha256, train
+from .training import load_model, read_sums, save, sha256, train, validation_error
 from .training import load, run  # the old names, for one release
 from .published import ZAHEER_TABLE2, ZAHEER_TABLE3
 from .cv import BASELINES, ERROR_COLUMNS, check_files, compare, compare_summary
 from .cv import cross_validate, folds, learned_estimate
 from .baselines import BASELINE_GRIDS, PARAMS_FILE, TUNED_BASELINES, load_tuned
 from .baselines import save_tuned, tune_baselines, tuned_compare, tuned_summary
+import tiltlab.learn.gain_schedule as _gain_schedule
+from .gain_schedule import GainTrial, fit_standardisation, gain_trial
+from .gain_schedule import schedule_loss, train_schedule
 from .tables import config_table, layer_settings, layer_table
 
 # every public name of data, model, optim, training, published and tables; of
@@ -76,4 +79,5 @@ __all__ = [
     "tuned_summary",
     *_published.__all__,
     *_tables.__all__,
+    *_gain_schedule.__all__,
 ]
