@@ -59,6 +59,7 @@ FILTERS = [
     ("ESKF 9D", "eskf", True),
     ("VQF 9D", "vqf", True),
     ("RIANN 6D", "riann", False),
+    ("learned gain 6D", "learned_gain", False),
 ]
 WARMUP = 2000  # samples of the untimed warm-up call
 
@@ -105,6 +106,7 @@ def print_learn_scaling(rec, inputs, models, threads: int, repeat: int) -> None:
     cases = [
         ("Mahony 9D", lambda k: F.run_method("mahony", x9[k])),
         ("RIANN 6D", lambda k: F.run_method("riann", x6[k])),
+        ("learned gain 6D", lambda k: F.run_method("learned_gain", x6[k])),
     ]
     seqs = {}
     for variant, (model, cfg) in models.items():

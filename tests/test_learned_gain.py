@@ -179,3 +179,26 @@ def test_short_broad_trial_runs_and_is_accurate(data_mirror):
     assert broad_errors(q, rec)["inclination"] < 5.0
     with pytest.raises(ValueError, match="magnetometer"):
         filters.estimate(rec, "learned_gain", weights=str(WEIGHTS), use_mag=True)
+
+
+@pytest.mark.realdata
+def test_gain_compare_scores_each_trial_with_its_folds_learned_and_parent_weights(
+    data_mirror,
+):
+    from tiltlab import datasets, learn
+    from tiltlab.filters.learned_gain import GainWeights, load_gain_weights
+
+    folder = WEIGHTS.parent
+    folds = [[1, 6], [2, 7], [3, 8], [4, 9], [5, 10]]
+    short = {2: datasets.load_broad_trial(2).isel(time=slice(0, 20000))}
+    table = learn.gain_compare(folds, folder, trials=[2], load=short.__getitem__)
+    assert list(table["method"]) == list(learn.GAIN_LABELS)
+    w = load_gain_weights(folder / "fold1.json")  # trial 2 is held out by fold 1
+    parent = GainWeights.parent(w.kp, w.ki, w.kb, w.tau_acc_s, w.mean, w.std)
+    q = filters.estimate(short[2], "learned_gain", weights=parent)
+    expected = learn.cv.trial_errors(q.values, short[2])["inclination"]
+    got = table.set_index("method").loc[learn.GAIN_LABELS[1], "inclination"]
+    assert got == pytest.approx(expected, rel=1e-12)
+    assert "GainWeights(kp=" in q.attrs["param_weights"]
+    with pytest.raises(ValueError, match="held out by no fold"):
+        learn.gain_compare(folds, folder, trials=[11], load=short.__getitem__)

@@ -54,8 +54,27 @@ def check(nb_path: Path, params: dict) -> str:
         )
     return (
         f"{n_methods} methods on trials {trials}; {params['SOURCE']} inclination "
-        f"{got[0]} deg (package: {expected:.2f} deg); {check_statements(nb_path)}"
+        f"{got[0]} deg (package: {expected:.2f} deg); {check_statements(nb_path)}; "
+        f"{_check_gain(nb_path, trials, folds)}"
     )
+
+
+def _check_gain(nb_path: Path, trials: list[int], folds: list) -> str:
+    """§4.1: the glued count of trials where the learned-gain filter beats its parent,
+    and the verdict on p, recomputed with ``learn.gain_compare``."""
+    from tiltlab import learn
+
+    values = glued(nb_path)
+    rows = learn.gain_compare(folds, trials=trials)
+    wide = rows.pivot_table(index="trial", columns="method", values="inclination")
+    learned, parent = learn.GAIN_LABELS
+    n_better = int((wide[learned] < wide[parent]).sum())
+    if int(glued_float(values, "ch5_gain_n_better")) != n_better:
+        raise AssertionError(f"glued learned-gain wins differ from {n_better}")
+    sentence = _words(values, "ch5_gain_vs_parent")
+    if f"on {n_better} of {len(wide)} held-out trials" not in sentence:
+        raise AssertionError(f"learned-gain sentence {sentence!r} vs {n_better} wins")
+    return f"learned gain beats its parent on {n_better} of {len(wide)} trials"
 
 
 def _summary_lines(nb_path: Path) -> dict[str, tuple[float, float, int, float]]:

@@ -491,7 +491,7 @@ def _read_weights(weights: Any) -> GainWeights:
         if not BROAD_WEIGHTS.is_file():
             raise FileNotFoundError(
                 f"weights='broad' reads {BROAD_WEIGHTS}, which this installation "
-                "lacks (it is in the tiltlab repository); pass a weights file"
+                "lacks (the package ships it as package data); pass a weights file"
             )
         return load_gain_weights(BROAD_WEIGHTS)
     if isinstance(weights, (str, os.PathLike)):

@@ -184,13 +184,21 @@ def attr_value(v):
     Returns
     -------
     object
-        ``"none"`` for None, an int for a bool, a float array for an array, list or
+        ``"none"`` for None, an int for a bool, a string of its scalar fields for a
+        parameter record (a named tuple), a float array for an array, list or
         tuple, else ``v`` itself.
     """
     if v is None:
         return "none"
     if isinstance(v, (bool, np.bool_)):
         return int(v)
+    if hasattr(v, "_fields"):  # a parameter record (e.g. learned weights): its scalars
+        scalars = [(f, getattr(v, f)) for f in v._fields]
+        return (
+            f"{type(v).__name__}("
+            + ", ".join(f"{f}={x:g}" for f, x in scalars if isinstance(x, (int, float)))
+            + ")"
+        )
     if isinstance(v, (np.ndarray, list, tuple)):
         return np.asarray(v, float)
     return v

@@ -45,7 +45,8 @@ from .cv import cross_validate, folds, learned_estimate
 from .baselines import BASELINE_GRIDS, PARAMS_FILE, TUNED_BASELINES, load_tuned
 from .baselines import save_tuned, tune_baselines, tuned_compare, tuned_summary
 import tiltlab.learn.gain_schedule as _gain_schedule
-from .gain_schedule import GainTrial, fit_standardisation, gain_trial
+from .gain_schedule import GAIN_LABELS, GainTrial, fit_standardisation, gain_compare
+from .gain_schedule import gain_trial
 from .gain_schedule import schedule_loss, train_schedule
 from .tables import config_table, layer_settings, layer_table
 

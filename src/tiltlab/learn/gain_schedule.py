@@ -34,6 +34,7 @@ from collections.abc import Sequence
 from typing import NamedTuple
 
 import numpy as np
+import pandas as pd
 from numba import njit
 from scipy.optimize import minimize
 
@@ -50,6 +51,8 @@ from ..filters.learned_gain import (
 from ..quaternion import rotate_scalar
 
 __all__ = [
+    "GAIN_LABELS",
+    "gain_compare",
     "GainTrial",
     "gain_trial",
     "schedule_loss",
@@ -444,3 +447,74 @@ def train_schedule(
     hist["validation_parent"] = val0
     hist["seconds"] = time.perf_counter() - t0
     return _with(base, best[1]), hist
+
+
+#: Row labels of :func:`gain_compare`: the learned schedule and its fixed-gain parent.
+GAIN_LABELS = ("learned gain 6D", "learned gain's parent 6D")
+
+
+def gain_compare(
+    folds: Sequence[Sequence[int]],
+    weights_dir=None,
+    *,
+    trials: Sequence[int] | None = None,
+    load=None,
+) -> pd.DataFrame:
+    """Score the learned-gain filter and its fixed-gain parent on held-out trials.
+
+    Each trial is estimated with the weights of the fold that held it out
+    (``fold<k>.json`` in ``weights_dir``, checked against its ``SHA256SUMS``): once
+    with the learned schedule and once with the same weights' zero schedule (the
+    parent, :meth:`~tiltlab.filters.learned_gain.GainWeights.parent`), so the two
+    differ only by what was learned.
+
+    Parameters
+    ----------
+    folds : sequence of sequence of int
+        The held-out trials of each fold (``run.json``'s ``folds``).
+    weights_dir : str or path, optional
+        Folder with ``fold0.json`` … and their ``SHA256SUMS``; default the weights
+        shipped with the package (trained on the CNN folds of chapter 5).
+    trials : sequence of int, optional
+        Trials to score (default: every trial of ``folds``).
+    load : callable, optional
+        Trial number → Recording (default :func:`tiltlab.datasets.load_broad_trial`).
+
+    Returns
+    -------
+    pandas.DataFrame
+        Rows (method, trial) with :func:`~tiltlab.learn.cv.trial_errors` columns,
+        labelled like :func:`~tiltlab.learn.cv.compare`; methods :data:`GAIN_LABELS`.
+
+    Raises
+    ------
+    ValueError
+        A trial that no fold holds out, or a weights file that fails its checksum.
+    """
+    from pathlib import Path
+
+    from .. import datasets
+    from ..filters import estimate
+    from ..filters.learned_gain import BROAD_WEIGHTS, GainWeights, load_gain_weights
+    from .cv import _label_errors, trial_errors
+
+    fold_of = {int(t): k for k, f in enumerate(folds) for t in f}
+    trials = sorted(fold_of) if trials is None else [int(t) for t in trials]
+    missing = [t for t in trials if t not in fold_of]
+    if missing:
+        raise ValueError(f"trials {missing} are held out by no fold")
+    load = load or datasets.load_broad_trial
+    weights_dir = BROAD_WEIGHTS.parent if weights_dir is None else weights_dir
+    weights = {
+        k: load_gain_weights(Path(weights_dir) / f"fold{k}.json")
+        for k in sorted({fold_of[t] for t in trials})
+    }
+    rows = []
+    for t in trials:
+        rec = load(t)
+        w = weights[fold_of[t]]
+        parent = GainWeights.parent(w.kp, w.ki, w.kb, w.tau_acc_s, w.mean, w.std)
+        for label, ww in zip(GAIN_LABELS, (w, parent)):
+            q = estimate(rec, "learned_gain", weights=ww)
+            rows.append({"method": label, "trial": t} | trial_errors(q.values, rec))
+    return _label_errors(pd.DataFrame(rows))
