@@ -253,7 +253,14 @@ def test_saved_weights_carry_their_digest(learn, tmp_path, recwarn):
 
 
 def test_weights_with_no_record_load_with_a_warning(learn, tmp_path):
-    shutil.copy(COMMITTED / "gain_fold0.pt", tmp_path / "alone.pt")
+    """A file saved before weights carried their digest, alone (no SHA256SUMS)."""
+    import torch
+
+    blob = torch.load(
+        COMMITTED / "gain_fold0.pt", map_location="cpu", weights_only=True
+    )
+    blob.pop("sha256", None)
+    torch.save(blob, tmp_path / "alone.pt")
     with pytest.warns(UserWarning, match=r"alone\.pt: no recorded sha256"):
         learn.load_model(tmp_path / "alone.pt")
 
