@@ -91,25 +91,28 @@ def main() -> None:
         keys = [g for g in grid if (g[3] == 0) == mahony]
         return min(keys, key=lambda g: np.mean([grid[g][t] for t in train]))
 
-    out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
-    rows, fold_info, train_s = [], [], 0.0
-    for i, held in enumerate(folds):
-        train = [t for t in trials if t not in held]
-        kp, ki, kb, tau = tune(train)
-        mkp, mki, _, _ = tune(train, mahony=True)
+    def fit_schedule(train):
+        """Tune the parent on ``train``, then train its schedule on all but every
+        sixth of those trials (the validation trials for early stopping)."""
+        parent = tune(train)
         val = train[::6]
         fit = [t for t in train if t not in val]
         w, hist = train_schedule(
             [prepared[t] for t in fit],
             [prepared[t] for t in val],
-            kp,
-            ki,
-            kb,
-            tau,
+            *parent,
             l2=args.l2,
             max_iter=args.max_iter,
         )
+        return parent, fit, val, w, hist
+
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    rows, fold_info, train_s = [], [], 0.0
+    for i, held in enumerate(folds):
+        train = [t for t in trials if t not in held]
+        (kp, ki, kb, tau), fit, val, w, hist = fit_schedule(train)
+        mkp, mki, _, _ = tune(train, mahony=True)
         train_s += hist["seconds"]
         w = w._replace(
             meta={"fold": i, "train": fit, "validation": val, "held_out": held}
@@ -161,19 +164,7 @@ def main() -> None:
     )
     summary["n_better"] = int(np.sum(lp < pp))
     # final model on all 30 trials
-    kp, ki, kb, tau = tune(trials)
-    val = trials[::6]
-    fit = [t for t in trials if t not in val]
-    w, hist = train_schedule(
-        [prepared[t] for t in fit],
-        [prepared[t] for t in val],
-        kp,
-        ki,
-        kb,
-        tau,
-        l2=args.l2,
-        max_iter=args.max_iter,
-    )
+    (kp, ki, kb, tau), fit, val, w, hist = fit_schedule(trials)
     w = w._replace(
         meta={
             "trained_on": "BROAD",

@@ -7,7 +7,7 @@ estimate towards the measured rate; the correction uses the specific force low-p
 in the world frame (VQF's device against linear accelerations). With all weights zero it *is* the parent filter
 with its tuned fixed gains (:func:`~tiltlab.filters.mahony` itself when the rest-bias
 gain is 0); :mod:`tiltlab.learn.gain_schedule` trains the weights by back-propagation
-through the whole filter recursion. Weights trained on BROAD are in the repository's
+through the whole filter recursion. Weights trained on BROAD ship with the package:
 ``tiltlab/_weights/learned_gain/weights.json`` (with ``SHA256SUMS``; ``tools/train_learned_gain.py``
 writes them).
 
