@@ -1,6 +1,7 @@
 """tiltlab.learn: losses, optimiser, model readings, data windows, deterministic
 training, model files and the committed cross-validation."""
 
+import dataclasses
 import json
 import math
 from pathlib import Path
@@ -240,6 +241,52 @@ def test_training_is_deterministic_and_the_loss_decreases(small_sequences):
     assert h1[-1]["loss"] < h1[0]["loss"]
     other, _ = learn.train(seqs, _small_config(lr=2e-3))
     assert not torch.equal(m1.head.weight, other.head.weight)
+
+
+def _head(seq, n):
+    """The first ``n`` samples of a Sequence."""
+    cut = {f: getattr(seq, f)[:n] for f in ("Q", "acc", "mag", "q_vec", "q_ref")}
+    return dataclasses.replace(seq, **cut)
+
+
+@pytest.mark.realdata
+def test_closed_loop_batched_across_sequences_equals_one_by_one(small_sequences):
+    """Batching across recordings changes only float32 rounding, not the recursion."""
+    _, (a, b) = small_sequences
+    b = _head(b, 4500)
+    cfg = _small_config(variant="gain")
+    model, _ = learn.train([a], cfg, max_steps=3)
+    with torch.no_grad():
+        alone = [learn.closed_loop_estimate(model, s, cfg) for s in (a, b)]
+        together = learn.closed_loop_estimates(model, [a, b], cfg)
+        single = learn.closed_loop_estimates(model, [a], cfg)
+    assert [q.shape for q in together] == [(len(a), 4), (4500, 4)]
+    assert np.array_equal(single[0], alone[0])  # one sequence: the same batches
+    for q, r in zip(together, alone):
+        assert np.max(quat.total_error(q, r)) < 1e-5
+    assert learn.closed_loop_estimates(model, [], cfg) == []
+    with pytest.raises(ValueError, match="different sampling rates"):
+        learn.closed_loop_estimates(
+            model, [a, dataclasses.replace(b, fs=2 * b.fs)], cfg
+        )
+    with pytest.raises(ValueError, match="has 10 samples"):
+        learn.closed_loop_estimates(model, [a, _head(b, 10)], cfg)
+
+
+@pytest.mark.realdata
+def test_compare_batches_a_fold_and_keeps_the_per_trial_result(data_mirror):
+    folder = COMMITTED
+    table = learn.compare(folder, trials=[6, 1])  # both held out by fold 0
+    assert list(table["trial"].unique()) == [1, 6]
+    first = table[table["trial"] == 1]["method"].tolist()
+    assert first[:2] == ["CNN (quaternion)", "CNN (learned gain)"]
+    assert first[2:] == list(learn.BASELINES)
+    for t in (1, 6):
+        rec = datasets.load_broad_trial(t)
+        q = learn.learned_estimate(rec, folder / "gain_fold0.pt")
+        alone = learn.cv.trial_errors(q.values, rec)["inclination"]
+        row = table[(table["trial"] == t) & (table["method"] == "CNN (learned gain)")]
+        assert abs(float(row["inclination"].iloc[0]) - alone) < 1e-4
 
 
 @pytest.mark.realdata

@@ -1,6 +1,7 @@
 """Train and cross-validate the learned-gain Mahony filter on BROAD (issue #26).
 
 Usage: ``python tools/train_learned_gain.py [--out src/tiltlab/_weights/learned_gain] [--results FILE]``
+or ``python tools/train_learned_gain.py --loto data/learn_gain_loto`` (leave one trial out).
 
 Uses the 5 folds of the committed CNNs (``data/learn/run.json``). Per fold: grid
 search on the 24 training trials (mean inclination RMSE) of the parent's fixed gains
@@ -12,6 +13,15 @@ Across the 30 held-out trials: one-sided paired Wilcoxon signed-rank tests (lear
 < parent, learned < VQF 6D), with VQF 6D/9D on the same trials.
 Finally a model trained on all 30 trials is written to ``--out`` (``weights.json``,
 with the fold models ``fold<i>.json`` and ``SHA256SUMS``). Single-threaded.
+
+With ``--loto DIR`` it instead runs the paper's protocol (leave one trial out): for
+each of the 30 trials, the parent is tuned and the schedule trained (validation
+trials by :func:`tiltlab.learn.cv.validation_split`) on the other 29, and the
+weights are written to ``DIR/fold<k>.json`` for the k-th trial in increasing order
+(with ``SHA256SUMS`` and ``run.json``, whose ``folds`` lists each model's held-out
+trial and ``models`` its tuned parent), so that
+:func:`tiltlab.learn.gain_compare` scores them like any folds. Scoring is left to the
+reader of the weights (chapter 5 runs them on the held-out trials).
 """
 
 from __future__ import annotations
@@ -28,6 +38,7 @@ from tiltlab.datasets import load_broad_trial
 from tiltlab.evaluate import broad_errors
 from tiltlab.filters._common import start_orientation
 from tiltlab.filters.learned_gain import GainWeights, learned_gain, save_gain_weights
+from tiltlab.learn.cv import validation_split
 from tiltlab.learn.gain_schedule import gain_trial, train_schedule
 from tiltlab.stats import wilcoxon_signed_rank
 
@@ -58,6 +69,7 @@ def main() -> None:
     ap.add_argument("--results", default="/tmp/learned_gain_results.json")
     ap.add_argument("--max-iter", type=int, default=100)
     ap.add_argument("--l2", type=float, default=1e-4)
+    ap.add_argument("--loto", default=None, help="leave-one-trial-out output folder")
     args = ap.parse_args()
     folds = json.loads(Path("data/learn/run.json").read_text())["folds"]
     trials = sorted(t for f in folds for t in f)
@@ -92,10 +104,10 @@ def main() -> None:
         return min(keys, key=lambda g: np.mean([grid[g][t] for t in train]))
 
     def fit_schedule(train):
-        """Tune the parent on ``train``, then train its schedule on all but every
-        sixth of those trials (the validation trials for early stopping)."""
+        """Tune the parent on ``train``, then train its schedule on all but one in
+        six of those trials (the validation trials for early stopping)."""
         parent = tune(train)
-        val = train[::6]
+        val = validation_split(train, -(-len(train) // 6))
         fit = [t for t in train if t not in val]
         w, hist = train_schedule(
             [prepared[t] for t in fit],
@@ -106,6 +118,9 @@ def main() -> None:
         )
         return parent, fit, val, w, hist
 
+    if args.loto:
+        _loto(Path(args.loto), trials, fit_schedule, grid_s)
+        return
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     rows, fold_info, train_s = [], [], 0.0
@@ -190,6 +205,39 @@ def main() -> None:
     }
     Path(args.results).write_text(json.dumps(res, indent=1))
     print(json.dumps(summary, indent=1))
+
+
+def _loto(out: Path, trials, fit_schedule, grid_s: float) -> None:
+    """Leave one trial out: a parent and a schedule per held-out trial."""
+    out.mkdir(parents=True, exist_ok=True)
+    models, total = {}, 0.0
+    for k, t in enumerate(trials):
+        train = [s for s in trials if s != t]
+        (kp, ki, kb, tau), fit, val, w, hist = fit_schedule(train)
+        total += hist["seconds"]
+        meta = {"fold": k, "held_out": [t], "train": fit, "validation": val}
+        save_gain_weights(w._replace(meta=meta), out / f"fold{k}.json")
+        models[f"fold{k}.json"] = {
+            "held_out": t,
+            "kp": kp,
+            "ki": ki,
+            "kb": kb,
+            "tau_acc_s": tau,
+            "iterations": len(hist["train"]),
+            "seconds": round(hist["seconds"], 1),
+        }
+        print(t, models[f"fold{k}.json"], flush=True)
+    run = {
+        "command": "python tools/train_learned_gain.py --loto " + str(out),
+        "protocol": "leave one trial out; parent tuned and schedule trained on the "
+        "other 29 trials, one in six of them kept for early stopping",
+        "threads": 1,
+        "folds": [[t] for t in trials],
+        "grid_seconds": round(grid_s, 1),
+        "train_seconds": round(total, 1),
+        "models": models,
+    }
+    (out / "run.json").write_text(json.dumps(run, indent=1) + "\n")
 
 
 if __name__ == "__main__":

@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from ..quaternion import qmul_scalar, rotate_scalar
-from ._shared_kernel import _unit_sample
+from ..quaternion import rotate_scalar
+from ._shared_kernel import _attitude_step, _gravity_error, _unit_sample
 
 
 @njit(cache=True, nogil=True)
@@ -21,11 +21,11 @@ def _mahony_kernel(acc, gyr, mag, use_mag, dt, kp, ki, q0, b0, out, bias):
         ex, ey, ez = 0.0, 0.0, 0.0
         have = False
         if an > 0.0:
-            # estimated gravity-up in the sensor frame: R(q)^T e_z
-            vx, vy, vz = rotate_scalar(w, -x, -y, -z, 0.0, 0.0, 1.0)
-            ex += ay * vz - az * vy
-            ey += az * vx - ax * vz
-            ez += ax * vy - ay * vx
+            # against the estimated gravity-up in the sensor frame, R(q)^T e_z
+            cx, cy, cz = _gravity_error(w, x, y, z, ax, ay, az)
+            ex += cx
+            ey += cy
+            ez += cz
             have = True
         if use_mag:
             mx, my, mz, mn = _unit_sample(mag, k)
@@ -49,11 +49,6 @@ def _mahony_kernel(acc, gyr, mag, use_mag, dt, kp, ki, q0, b0, out, bias):
             oz = oz - bz_ + kp * ez
         else:
             ox, oy, oz = ox - bx_, oy - by_, oz - bz_
-        # q ← (q + Δt/2 q ⊗ (0, Ω)) / ‖·‖
-        h = 0.5 * dt
-        dw, dx, dy, dz = qmul_scalar(w, x, y, z, 0.0, ox, oy, oz)
-        nw, nx, ny, nz = w + h * dw, x + h * dx, y + h * dy, z + h * dz
-        n = np.sqrt(nw * nw + nx * nx + ny * ny + nz * nz)
-        w, x, y, z = nw / n, nx / n, ny / n, nz / n
+        w, x, y, z = _attitude_step(w, x, y, z, ox, oy, oz, 0.5 * dt)
         out[k, 0], out[k, 1], out[k, 2], out[k, 3] = w, x, y, z
         bias[k, 0], bias[k, 1], bias[k, 2] = bx_, by_, bz_

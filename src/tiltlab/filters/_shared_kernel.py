@@ -1,9 +1,14 @@
-"""Numba helpers that the filters share: reading a unit sample, scanning inputs once."""
+"""Numba helpers that the filters share.
+
+Reading a unit sample, Mahony's gravity error and attitude step, scanning inputs once.
+"""
 
 from __future__ import annotations
 
 import numpy as np
 from numba import njit
+
+from ..quaternion import qmul_scalar, rotate_scalar
 
 
 @njit(cache=True, nogil=True, inline="always")
@@ -16,6 +21,23 @@ def _unit_sample(a, k):
         r = 1.0 / n  # one division, three products (the loops are latency-bound)
         return x * r, y * r, z * r, n
     return x, y, z, n
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _gravity_error(w, x, y, z, ax, ay, az):
+    # a × v for the unit measured direction a and the estimated gravity-up in the
+    # sensor frame v = R(q)^T e_z: the correction of Mahony's explicit filter
+    vx, vy, vz = rotate_scalar(w, -x, -y, -z, 0.0, 0.0, 1.0)
+    return ay * vz - az * vy, az * vx - ax * vz, ax * vy - ay * vx
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _attitude_step(w, x, y, z, ox, oy, oz, h):
+    # q <- (q + h q ⊗ (0, Ω)) / ‖·‖ with h = Δt/2 (first-order integration)
+    dw, dx, dy, dz = qmul_scalar(w, x, y, z, 0.0, ox, oy, oz)
+    nw, nx, ny, nz = w + h * dw, x + h * dx, y + h * dy, z + h * dz
+    n = np.sqrt(nw * nw + nx * nx + ny * ny + nz * nz)
+    return nw / n, nx / n, ny / n, nz / n
 
 
 @njit(cache=True, nogil=True)

@@ -27,10 +27,9 @@ from numba import njit
 
 from .. import _validate as _v
 from ..datasets import file_sha256
-from ..quaternion import qmul_scalar, rotate_scalar
 from ._common import offset_vector, read_sensors, start_orientation
 from ._docs import shared_docs
-from ._shared_kernel import _unit_sample
+from ._shared_kernel import _attitude_step, _gravity_error, _unit_sample
 
 __all__ = [
     "BROAD_WEIGHTS",
@@ -431,10 +430,8 @@ def _varying_mahony_kernel(acc, gyr, dt, alpha, gains, q0, b0, out, bias, facc):
         else:
             ax, ay, az, an = _unit_sample(acc, k)
             if an > 0.0:
-                vx, vy, vz = rotate_scalar(w, -x, -y, -z, 0.0, 0.0, 1.0)
-                ex = 0.0 + (ay * vz - az * vy)
-                ey = 0.0 + (az * vx - ax * vz)
-                ez = 0.0 + (ax * vy - ay * vx)
+                cx, cy, cz = _gravity_error(w, x, y, z, ax, ay, az)
+                ex, ey, ez = 0.0 + cx, 0.0 + cy, 0.0 + cz  # as Mahony's ex += ...
                 have = True
         if have:
             kp, ki, kb = gains[0, k], gains[1, k], gains[2, k]
@@ -452,10 +449,7 @@ def _varying_mahony_kernel(acc, gyr, dt, alpha, gains, q0, b0, out, bias, facc):
             oz = oz - bz_ + kp * ez
         else:
             ox, oy, oz = ox - bx_, oy - by_, oz - bz_
-        dw, dx, dy, dz = qmul_scalar(w, x, y, z, 0.0, ox, oy, oz)
-        nw, nx, ny, nz = w + h * dw, x + h * dx, y + h * dy, z + h * dz
-        n = np.sqrt(nw * nw + nx * nx + ny * ny + nz * nz)
-        w, x, y, z = nw / n, nx / n, ny / n, nz / n
+        w, x, y, z = _attitude_step(w, x, y, z, ox, oy, oz, h)
         out[k, 0], out[k, 1], out[k, 2], out[k, 3] = w, x, y, z
         bias[k, 0], bias[k, 1], bias[k, 2] = bx_, by_, bz_
         facc[k, 0], facc[k, 1], facc[k, 2] = fx, fy, fz

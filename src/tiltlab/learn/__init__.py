@@ -37,6 +37,7 @@ from .losses import LOSSES, TOTALS, qae, sample_loss, total_loss
 from .model import ACTIVATIONS, OrientationCNN
 from .optim import Lookahead, radam_lookahead
 from .training import SUMS_FILE, TrainConfig, build_model, closed_loop_estimate
+from .training import closed_loop_estimates
 from .training import load_model, read_sums, save, sha256, train, validation_error
 from .training import load, run  # the old names, for one release
 from .published import ZAHEER_TABLE2, ZAHEER_TABLE3

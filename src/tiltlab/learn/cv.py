@@ -39,6 +39,7 @@ from .. import quaternion as quat
 from .data import sequence
 from ..io import IntegrityError
 from .training import SUMS_FILE, TrainConfig, closed_loop_estimate, load_model
+from .training import closed_loop_estimates
 from .training import read_sums, save, sha256, train, write_json
 
 __all__ = [
@@ -510,26 +511,35 @@ def learned_estimate(rec, weights: str | Path):
     )
 
 
-def _compare_trial(folder: str, trial: int, fold: int, variants: list[str]):
-    """Rows of :func:`compare` for one trial (run in a worker process)."""
+def _compare_trials(folder: str, trials: list[int], fold: int, variants: list[str]):
+    """Rows of :func:`compare` for some trials of one fold (run in a worker process).
+
+    The fold's CNNs estimate the trials together (:func:`closed_loop_estimates`,
+    one batch across trials at every block); the baselines run trial by trial.
+    """
     import torch
 
     torch.set_num_threads(1)
-    rec = datasets.load_broad_trial(trial)
+    recs = [datasets.load_broad_trial(t) for t in trials]
     rows = []
     for v in variants:
         model, cfg, _ = load_model(Path(folder) / f"{v}_fold{fold}.pt")
-        seq = sequence(rec, acc_scale=cfg.acc_scale, mag_scale=cfg.mag_scale)
-        q = closed_loop_estimate(model, seq, cfg)
+        seqs = [
+            sequence(r, acc_scale=cfg.acc_scale, mag_scale=cfg.mag_scale) for r in recs
+        ]
+        with torch.no_grad():
+            qs = closed_loop_estimates(model, seqs, cfg)
         label = "CNN (quaternion)" if v == "quaternion" else "CNN (learned gain)"
-        rows.append({"method": label, "trial": trial} | trial_errors(q, rec))
-    for label, (method, use_mag) in BASELINES.items():
-        q = filters.estimate(rec, method, use_mag=use_mag)
-        errs = trial_errors(q.values, rec)
-        if not use_mag:  # the heading of a 6D method is relative: tilt only
-            for key in ("heading", "total", "qae_mean", "qae_median"):
-                errs[key] = np.nan
-        rows.append({"method": label, "trial": trial} | errs)
+        for t, q, rec in zip(trials, qs, recs):
+            rows.append({"method": label, "trial": t} | trial_errors(q, rec))
+    for t, rec in zip(trials, recs):
+        for label, (method, use_mag) in BASELINES.items():
+            q = filters.estimate(rec, method, use_mag=use_mag)
+            errs = trial_errors(q.values, rec)
+            if not use_mag:  # the heading of a 6D method is relative: tilt only
+                for key in ("heading", "total", "qae_mean", "qae_median"):
+                    errs[key] = np.nan
+            rows.append({"method": label, "trial": t} | errs)
     return rows
 
 
@@ -553,15 +563,19 @@ def compare(
     trials : sequence of int, optional
         BROAD trials (default: every trial of a test fold).
     n_jobs : int
-        Worker processes (one trial each at a time).
+        Worker processes. Each fold's trials are split into ``n_jobs`` groups (one
+        group with ``n_jobs=1``); a worker estimates a group's trials with the
+        fold's CNNs in one batch (the closed loop is sequential in time, not across
+        trials), then runs the baselines.
     progress : bool
-        Show a progress bar.
+        Show a progress bar (trials done).
 
     Returns
     -------
     pandas.DataFrame
         Rows (method, trial) with :func:`trial_errors` columns; the heading, total
-        and QAE of the 6D RIANN are NaN (its heading origin is arbitrary).
+        and QAE of the 6D RIANN are NaN (its heading origin is arbitrary). Rows are
+        ordered by trial, then method, whatever ``n_jobs``.
     """
     import concurrent.futures as cf
     import multiprocessing as mp
@@ -578,21 +592,31 @@ def compare(
         if t not in fold_of:
             raise ValueError(f"trial {t} is in no test fold of {folder}")
     n_jobs = int(_v.integer(n_jobs, "n_jobs", minimum=1))
-    args = [(str(folder), t, fold_of[t], variants) for t in trials]
-    bar = tqdm(total=len(args), desc="trials", disable=not progress)
+    args = []
+    for k in sorted({fold_of[t] for t in trials}):
+        mine = [t for t in trials if fold_of[t] == k]
+        for part in np.array_split(np.array(mine), min(n_jobs, len(mine))):
+            args.append((str(folder), [int(t) for t in part], k, variants))
+    bar = tqdm(total=len(trials), desc="trials", disable=not progress)
     rows = []
     if n_jobs == 1:
         for a in args:
-            rows += _compare_trial(*a)
-            bar.update()
+            rows += _compare_trials(*a)
+            bar.update(len(a[1]))
     else:
         ctx = mp.get_context("spawn")
         with cf.ProcessPoolExecutor(n_jobs, mp_context=ctx) as pool:
-            for part in pool.map(_compare_trial, *zip(*args)):
+            for a, part in zip(args, pool.map(_compare_trials, *zip(*args))):
                 rows += part
-                bar.update()
+                bar.update(len(a[1]))
     bar.close()
-    return _label_errors(pd.DataFrame(rows))
+    order = {m: i for i, m in enumerate(["CNN (quaternion)", "CNN (learned gain)"])}
+    order |= {m: len(order) + i for i, m in enumerate(BASELINES)}
+    table = pd.DataFrame(rows)
+    table = table.sort_values(
+        ["trial", "method"], key=lambda c: c.map(order) if c.name == "method" else c
+    )
+    return _label_errors(table.reset_index(drop=True))
 
 
 def _label_errors(table: pd.DataFrame) -> pd.DataFrame:

@@ -53,6 +53,7 @@ __all__ = [
     "train",
     "validation_error",
     "closed_loop_estimate",
+    "closed_loop_estimates",
     "run",
     "save",
     "load_model",
@@ -476,30 +477,111 @@ def closed_loop_estimate(
         sample :math:`T + 1`, so a shorter recording would be pure gyroscope
         integration, never the model's estimate. The message gives both lengths.
     """
+    return closed_loop_estimates(model, [seq], config)[0]
+
+
+def closed_loop_estimates(
+    model: OrientationCNN, sequences: Seq[Sequence], config: TrainConfig
+) -> list[np.ndarray]:
+    r"""Estimate several sequences in closed loop at once, batched across sequences.
+
+    The same recursion as :func:`closed_loop_estimate`, which is sequential in time
+    only: at every block of :math:`T` outputs, the windows of all sequences that
+    still have samples there go through the network in one batch. Each sequence's
+    estimate depends on its own samples only (the network has no batch coupling in
+    evaluation mode), so the result equals estimating each sequence alone up to the
+    float32 rounding of a differently sized batch.
+
+    Parameters
+    ----------
+    model : OrientationCNN
+        Trained network (set to evaluation mode).
+    sequences : sequence of Sequence
+        Arrays of the recordings (:func:`tiltlab.learn.data.sequence`), all at the
+        same sampling rate; lengths may differ.
+    config : TrainConfig
+        Configuration the model was trained with.
+
+    Returns
+    -------
+    list of numpy.ndarray (N_i, 4)
+        Unit quaternions (w, x, y, z), float64, one array per sequence, in order.
+
+    Raises
+    ------
+    ValueError
+        Sequences at different sampling rates, or one too short for the window (see
+        :func:`closed_loop_estimate`).
+
+    Examples
+    --------
+    >>> import numpy as np, torch
+    >>> from tiltlab.learn import Sequence, TrainConfig, build_model
+    >>> cfg = TrainConfig(window_s=0.128)
+    >>> model = build_model(cfg, 300.0)
+    >>> def at_rest(n):  # identity orientation, gravity and field along z
+    ...     q = np.tile(np.float32([1, 0, 0, 0]), (n, 1))
+    ...     v = np.tile(np.float32([0, 0, 1]), (n, 1))
+    ...     return Sequence(q, v, v, q, None, 300.0, "rest")
+    >>> with torch.no_grad():
+    ...     out = closed_loop_estimates(model, [at_rest(50), at_rest(80)], cfg)
+    >>> [q.shape for q in out]
+    [(50, 4), (80, 4)]
+    """
     model.eval()
-    window = config.window(seq.fs)
-    n = len(seq)
-    if n < window + 2:
+    seqs = list(sequences)
+    if not seqs:
+        return []
+    fs = seqs[0].fs
+    other = [s.fs for s in seqs if abs(s.fs - fs) > 1e-9 * fs]
+    if other:
         raise ValueError(
-            f"the recording has {n} samples ({n / seq.fs:.3g} s at {seq.fs:g} Hz), but "
-            f"the model's window is {window} samples (window_s = {config.window_s:g} s): "
-            f"the network first runs at sample {window + 1}, so at least {window + 2} "
-            "samples are needed (a shorter recording would only integrate the gyroscope)"
+            f"the sequences have different sampling rates ({fs:.6g} and "
+            f"{other[0]:.6g} Hz): a batch runs one model at one rate"
         )
-    Q = torch.from_numpy(seq.Q)
-    acc, mag = torch.from_numpy(seq.acc), torch.from_numpy(seq.mag)
-    q_vec = torch.from_numpy(seq.q_vec)
-    out = torch.empty(n, 4)
-    head = min(n, window + 1)
-    q_init = _canonical(q_vec[:head].mean(0, keepdim=True))
-    q_init = q_init / q_init.norm()
-    out[:head] = qmul(q_init, qmul(_conj(Q[:1]), Q[:head]))
-    for b in range(head, n, window):
-        ends = torch.arange(b, min(b + window, n))
-        k = _indices(ends, window)
-        x = _inputs(Q, acc[k], mag[k], ends, out[ends - window], window)
-        out[ends] = model(x, q_vec[ends])
-    return _canonical(out).double().numpy()
+    window = config.window(fs)
+    for seq in seqs:
+        n = len(seq)
+        if n < window + 2:
+            raise ValueError(
+                f"the recording has {n} samples ({n / fs:.3g} s at {fs:g} Hz), but "
+                f"the model's window is {window} samples (window_s = "
+                f"{config.window_s:g} s): the network first runs at sample "
+                f"{window + 1}, so at least {window + 2} samples are needed (a "
+                "shorter recording would only integrate the gyroscope)"
+            )
+    arrays, outs = [], []
+    for seq in seqs:
+        Q = torch.from_numpy(seq.Q)
+        q_vec = torch.from_numpy(seq.q_vec)
+        out = torch.empty(len(seq), 4)
+        head = window + 1
+        q_init = _canonical(q_vec[:head].mean(0, keepdim=True))
+        q_init = q_init / q_init.norm()
+        out[:head] = qmul(q_init, qmul(_conj(Q[:1]), Q[:head]))
+        arrays.append((Q, torch.from_numpy(seq.acc), torch.from_numpy(seq.mag), q_vec))
+        outs.append(out)
+    for b in range(window + 1, max(len(s) for s in seqs), window):
+        live = [i for i, s in enumerate(seqs) if b < len(s)]
+        parts, qv, spans = [], [], []
+        for i in live:
+            Q, acc, mag, q_vec = arrays[i]
+            ends = torch.arange(b, min(b + window, len(seqs[i])))
+            k = _indices(ends, window)
+            parts.append(
+                _inputs(Q, acc[k], mag[k], ends, outs[i][ends - window], window)
+            )
+            qv.append(q_vec[ends])
+            spans.append(ends)
+        if len(live) == 1:
+            y = model(parts[0], qv[0])
+        else:
+            y = model(torch.cat(parts), torch.cat(qv))
+        start = 0
+        for i, ends in zip(live, spans):
+            outs[i][ends] = y[start : start + len(ends)]
+            start += len(ends)
+    return [_canonical(out).double().numpy() for out in outs]
 
 
 # ---------------------------------------------------------------- files
