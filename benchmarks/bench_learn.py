@@ -13,7 +13,10 @@ trial's first samples; samples/s; ratio = how many times slower than Mahony 9D):
 * CNN input: ``tiltlab.learn.sequence(rec)`` (reads the Recording, integrates the gyro,
   Davenport orientation of every sample), timed on its own;
 * CNN (quaternion) and CNN (learned gain): the closed-loop network loop
-  ``tiltlab.learn.closed_loop_estimate(model, seq, cfg)``, with ``torch.set_num_threads(1)`` and ``(2)``.
+  ``tiltlab.learn.closed_loop_estimate(model, seq, cfg)``, with ``torch.set_num_threads(1)`` and ``(2)``;
+  and "batched xB": ``tiltlab.learn.closed_loop_estimates(model, [seq] * B, cfg)`` (B = 6
+  recordings in one batch, as chapter 5 runs a fold's trials; the first of ``--threads``),
+  its samples/s counting all B recordings.
   The end to end cost of a CNN is its input row plus its loop row (printed below the
   table).
 
@@ -54,6 +57,7 @@ from _timing import best_of
 ROOT = Path(__file__).resolve().parents[1]
 MODEL_DIRS = (ROOT / "data" / "learn", Path("/tmp/quick"))
 VARIANTS = {"quaternion": "CNN (quaternion)", "gain": "CNN (learned gain)"}
+BATCH = 6  # recordings per batch in the batched CNN rows (a fold's test trials)
 FILTERS = [
     ("Mahony 9D", "mahony", True),
     ("ESKF 9D", "eskf", True),
@@ -206,15 +210,21 @@ def main() -> None:
             L.closed_loop_estimate(model, head(seq, WARMUP), cfg)  # warm-up
             t = median_of(lambda: L.closed_loop_estimate(model, seq, cfg), repeat)
             rows.append((VARIANTS[variant], str(threads), t))
+        torch.set_num_threads(args.threads[0])
+        many = [seq] * BATCH
+        t = median_of(lambda: L.closed_loop_estimates(model, many, cfg), repeat)
+        rows.append(
+            (f"{VARIANTS[variant]} batched x{BATCH}", str(args.threads[0]), t / BATCH)
+        )
 
     t_mahony = rows[0][2]
     print(
-        f"\n{'method':22s} {'torch threads':>13s} {'median (s)':>11s} "
+        f"\n{'method':30s} {'torch threads':>13s} {'median (s)':>11s} "
         f"{'samples/s':>12s} {'vs Mahony':>10s}"
     )
     for label, threads, t in rows:
         print(
-            f"{label:22s} {threads:>13s} {t:11.4f} {n / t:12,.0f} {t / t_mahony:9.1f}x"
+            f"{label:30s} {threads:>13s} {t:11.4f} {n / t:12,.0f} {t / t_mahony:9.1f}x"
         )
 
     t_in = dict((r[0], r[2]) for r in rows)["CNN input (sequence)"]

@@ -527,8 +527,7 @@ def _compare_trials(folder: str, trials: list[int], fold: int, variants: list[st
         seqs = [
             sequence(r, acc_scale=cfg.acc_scale, mag_scale=cfg.mag_scale) for r in recs
         ]
-        with torch.no_grad():
-            qs = closed_loop_estimates(model, seqs, cfg)
+        qs = closed_loop_estimates(model, seqs, cfg)
         label = "CNN (quaternion)" if v == "quaternion" else "CNN (learned gain)"
         for t, q, rec in zip(trials, qs, recs):
             rows.append({"method": label, "trial": t} | trial_errors(q, rec))

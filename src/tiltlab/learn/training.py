@@ -480,6 +480,7 @@ def closed_loop_estimate(
     return closed_loop_estimates(model, [seq], config)[0]
 
 
+@torch.no_grad()
 def closed_loop_estimates(
     model: OrientationCNN, sequences: Seq[Sequence], config: TrainConfig
 ) -> list[np.ndarray]:
@@ -515,7 +516,7 @@ def closed_loop_estimates(
 
     Examples
     --------
-    >>> import numpy as np, torch
+    >>> import numpy as np
     >>> from tiltlab.learn import Sequence, TrainConfig, build_model
     >>> cfg = TrainConfig(window_s=0.128)
     >>> model = build_model(cfg, 300.0)
@@ -523,8 +524,7 @@ def closed_loop_estimates(
     ...     q = np.tile(np.float32([1, 0, 0, 0]), (n, 1))
     ...     v = np.tile(np.float32([0, 0, 1]), (n, 1))
     ...     return Sequence(q, v, v, q, None, 300.0, "rest")
-    >>> with torch.no_grad():
-    ...     out = closed_loop_estimates(model, [at_rest(50), at_rest(80)], cfg)
+    >>> out = closed_loop_estimates(model, [at_rest(50), at_rest(80)], cfg)
     >>> [q.shape for q in out]
     [(50, 4), (80, 4)]
     """
