@@ -41,6 +41,14 @@ def test_static_tilt_converges_to_the_accelerometer_direction():
     assert err < 1.0
 
 
+def test_threads_change_the_speed_not_the_numbers():
+    acc, gyr, _ = _static(seconds=3.0)
+    acc = acc + np.random.default_rng(1).normal(0.0, 0.2, acc.shape)
+    assert np.array_equal(run_riann(acc, gyr, FS, threads=1), run_riann(acc, gyr, FS))
+    with pytest.raises(ValueError, match="threads"):
+        run_riann(acc, gyr, FS, threads=0)
+
+
 def test_mag_is_refused_6d_only():
     acc, gyr, _ = _static(seconds=1.0)
     with pytest.raises(ValueError, match="mag"):
@@ -77,7 +85,7 @@ def test_registry_lists_riann_as_an_adapter():
     assert "riann" in F.methods() and "riann" in F.methods("adapter")
     m = F.get_method("riann")
     assert m.kind == "adapter" and m.function is run_riann
-    assert m.defaults == {} and m.uses_gyr
+    assert m.defaults == {"threads": None} and m.uses_gyr  # threads: speed only
 
 
 @pytest.fixture(scope="module")

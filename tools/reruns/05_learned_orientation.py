@@ -10,6 +10,7 @@ from ._common import glued, glued_float, printed
 
 PARAMS = {"TRIALS": [6, 28], "EXAMPLE_TRIAL": 6, "SOURCE": "broad:10", "N_JOBS": 1}
 MODELS = Path(__file__).resolve().parents[2] / "data" / "learn"
+LOTO = Path(__file__).resolve().parents[2] / "data" / "learn_gain_loto"
 CNNS = ("CNN (quaternion)", "CNN (learned gain)")
 HALF = 0.005  # half a unit of the 2-decimal numbers the chapter prints
 
@@ -55,7 +56,7 @@ def check(nb_path: Path, params: dict) -> str:
     return (
         f"{n_methods} methods on trials {trials}; {params['SOURCE']} inclination "
         f"{got[0]} deg (package: {expected:.2f} deg); {check_statements(nb_path)}; "
-        f"{_check_gain(nb_path, trials, folds)}"
+        f"{_check_gain(nb_path, trials, folds)}; {_check_loto(nb_path, trials)}"
     )
 
 
@@ -75,6 +76,25 @@ def _check_gain(nb_path: Path, trials: list[int], folds: list) -> str:
     if f"on {n_better} of {len(wide)} held-out trials" not in sentence:
         raise AssertionError(f"learned-gain sentence {sentence!r} vs {n_better} wins")
     return f"learned gain beats its parent on {n_better} of {len(wide)} trials"
+
+
+def _check_loto(nb_path: Path, trials: list[int]) -> str:
+    """§4.2: the glued leave-one-trial-out count and mean, recomputed from the
+    committed per-trial models with ``learn.gain_compare``."""
+    from tiltlab import learn
+
+    folds = json.loads((LOTO / "run.json").read_text())["folds"]
+    rows = learn.gain_compare(folds, LOTO, trials=trials)
+    wide = rows.pivot_table(index="trial", columns="method", values="inclination")
+    learned, parent = learn.GAIN_LABELS
+    n_better = int((wide[learned] < wide[parent]).sum())
+    sentence = _words(glued(nb_path), "ch5_loto")
+    expected = f"below its own parent on {n_better} of {len(wide)} trials"
+    mean = f"mean inclination RMSE is {wide[learned].mean():.3f}°"
+    for part in (expected, mean):
+        if part not in sentence:
+            raise AssertionError(f"leave-one-out sentence {sentence!r} lacks {part!r}")
+    return f"leave one out: {expected}"
 
 
 def _summary_lines(nb_path: Path) -> dict[str, tuple[float, float, int, float]]:

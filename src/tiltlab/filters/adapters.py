@@ -288,7 +288,9 @@ RIANN_CHUNK = 50_000
 
 
 @shared_docs
-def run_riann(acc, gyr, fs: float | None = None, *, mag=None) -> np.ndarray:
+def run_riann(
+    acc, gyr, fs: float | None = None, *, mag=None, threads: int | None = None
+) -> np.ndarray:
     """Run RIANN, a published recurrent network for attitude estimation (``riann``), 6D.
 
     The network takes the sampling interval as an input, so any rate is accepted.
@@ -299,6 +301,10 @@ def run_riann(acc, gyr, fs: float | None = None, *, mag=None) -> np.ndarray:
     mag : None
         Present for the adapters' uniform signature only: RIANN is a 6D method, and any
         ``mag`` other than None is a ValueError.
+    threads : int, optional
+        Threads of the ONNX runtime within the network's operations (None: the
+        runtime's default, one per core). Pass 1 when several recordings run in
+        parallel processes: threads beyond the idle cores wait on each other.
 
     Returns
     -------
@@ -310,7 +316,8 @@ def run_riann(acc, gyr, fs: float | None = None, *, mag=None) -> np.ndarray:
     ImportError
         The ``riann`` package (or ``onnxruntime``) is not installed.
     ValueError
-        ``mag`` given, an invalid ``fs``, or non-finite or mismatched ``acc``/``gyr``.
+        ``mag`` given, an invalid ``fs``, non-finite or mismatched ``acc``/``gyr``, or
+        ``threads`` below 1.
 
     Notes
     -----
@@ -335,7 +342,8 @@ def run_riann(acc, gyr, fs: float | None = None, *, mag=None) -> np.ndarray:
     try:
         import importlib.resources
 
-        from riann.riann import RIANN
+        import onnxruntime as rt
+        import riann  # noqa: F401  (the package that ships the model)
     except ImportError as e:
         raise ImportError(
             "run_riann needs the 'riann' package and onnxruntime: install the learn "
@@ -348,10 +356,14 @@ def run_riann(acc, gyr, fs: float | None = None, *, mag=None) -> np.ndarray:
             "RIANN is a 6D method (accelerometer and gyroscope) and takes no "
             "magnetometer: pass mag=None"
         )
+    options = rt.SessionOptions()
+    if threads is not None:
+        options.intra_op_num_threads = int(_v.integer(threads, "threads", minimum=1))
+        options.inter_op_num_threads = 1
     acc, gyr, _, _ = sensor_inputs(acc, gyr)
     model = importlib.resources.files("riann") / "riann.onnx"
     with importlib.resources.as_file(model) as path:
-        net = RIANN(str(path))
+        session = rt.InferenceSession(str(path), options)
     # Chunks with the recurrent state carried across them: the same numbers as one
     # call over the whole sequence (bitwise, checked in the tests), with memory bounded
     # by the chunk (the runtime's work arrays grow by ~4 kB per sample of a call).
@@ -360,9 +372,7 @@ def run_riann(acc, gyr, fs: float | None = None, *, mag=None) -> np.ndarray:
     h = np.zeros((2, 1, 1, 200), dtype=np.float32)
     q = np.empty((acc.shape[0], 4))
     for start in range(0, acc.shape[0], RIANN_CHUNK):
-        out = net.session.run(
-            [], {"input": x[None, start : start + RIANN_CHUNK], "h0": h}
-        )
+        out = session.run([], {"input": x[None, start : start + RIANN_CHUNK], "h0": h})
         q[start : start + RIANN_CHUNK] = out[0][0]
         h = out[1]
     return q / np.linalg.norm(q, axis=1, keepdims=True)

@@ -31,15 +31,17 @@ import tiltlab.learn.optim as _optim
 import tiltlab.learn.published as _published
 import tiltlab.learn.tables as _tables
 import tiltlab.learn.training as _training
+import tiltlab.learn.files as _files
 
 from .data import Sequence, sequence, window_ends
 from .losses import LOSSES, TOTALS, qae, sample_loss, total_loss
 from .model import ACTIVATIONS, OrientationCNN
 from .optim import Lookahead, radam_lookahead
-from .training import SUMS_FILE, TrainConfig, build_model, closed_loop_estimate
-from .training import closed_loop_estimates
-from .training import load_model, read_sums, save, sha256, train, validation_error
-from .training import load, run  # the old names, for one release
+from .training import TrainConfig, build_model, closed_loop_estimate
+from .training import closed_loop_estimates, train, validation_error
+from .files import SUMS_FILE, load_model, read_sums, save, sha256
+from .training import run  # the old name, for one release
+from .files import load  # the old name, for one release
 from .published import ZAHEER_TABLE2, ZAHEER_TABLE3
 from .cv import BASELINES, ERROR_COLUMNS, check_files, compare, compare_summary
 from .cv import cross_validate, folds, learned_estimate
@@ -51,8 +53,8 @@ from .gain_schedule import gain_trial
 from .gain_schedule import schedule_loss, train_schedule
 from .tables import config_table, layer_settings, layer_table
 
-# every public name of data, model, optim, training, published and tables; of
-# losses, cv and baselines, those listed here
+# every public name of data, model, optim, training, files (but write_json), published
+# and tables; of losses, cv and baselines, those listed here
 __all__ = [
     *_data.__all__,
     "LOSSES",
@@ -63,6 +65,7 @@ __all__ = [
     *_model.__all__,
     *_optim.__all__,
     *_training.__all__,
+    *[n for n in _files.__all__ if n != "write_json"],
     "BASELINES",
     "ERROR_COLUMNS",
     "check_files",

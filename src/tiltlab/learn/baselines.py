@@ -35,7 +35,7 @@ from .. import filters
 from .._labels import label_columns
 from ..stats import wilcoxon_signed_rank
 from .cv import ERROR_COLUMNS, check_files, trial_errors
-from .training import SUMS_FILE, sha256
+from .files import SUMS_FILE, sha256
 
 __all__ = [
     "TUNED_BASELINES",

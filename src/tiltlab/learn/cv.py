@@ -38,9 +38,8 @@ from .. import filters
 from .. import quaternion as quat
 from .data import sequence
 from ..io import IntegrityError
-from .training import SUMS_FILE, TrainConfig, closed_loop_estimate, load_model
-from .training import closed_loop_estimates
-from .training import read_sums, save, sha256, train, write_json
+from .files import SUMS_FILE, load_model, read_sums, save, sha256, write_json
+from .training import TrainConfig, closed_loop_estimate, closed_loop_estimates, train
 
 __all__ = [
     "ABLATIONS",
@@ -418,7 +417,7 @@ def _write_sums(out: Path) -> None:
 def check_files(folder: str | Path) -> dict[str, str]:
     """Verify every file listed in ``folder/SHA256SUMS``; return name -> sha256.
 
-    ``SHA256SUMS`` is parsed strictly (:func:`~tiltlab.learn.training.read_sums`):
+    ``SHA256SUMS`` is parsed strictly (:func:`~tiltlab.learn.files.read_sums`):
     blank lines are ignored and the ``*`` binary marker accepted; an empty file or a
     malformed line is an error naming the line.
 
@@ -531,9 +530,12 @@ def _compare_trials(folder: str, trials: list[int], fold: int, variants: list[st
         label = "CNN (quaternion)" if v == "quaternion" else "CNN (learned gain)"
         for t, q, rec in zip(trials, qs, recs):
             rows.append({"method": label, "trial": t} | trial_errors(q, rec))
+    one_thread = {"riann": {"threads": 1}}  # the workers share the cores
     for t, rec in zip(trials, recs):
         for label, (method, use_mag) in BASELINES.items():
-            q = filters.estimate(rec, method, use_mag=use_mag)
+            q = filters.estimate(
+                rec, method, use_mag=use_mag, **one_thread.get(method, {})
+            )
             errs = trial_errors(q.values, rec)
             if not use_mag:  # the heading of a 6D method is relative: tilt only
                 for key in ("heading", "total", "qae_mean", "qae_median"):

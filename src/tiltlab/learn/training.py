@@ -23,25 +23,17 @@ from __future__ import annotations
 
 import copy
 import dataclasses
-import hashlib
-import json
 import math
-import re
 import time
-import warnings
 from collections.abc import Callable, Sequence as Seq
 from dataclasses import dataclass
-from pathlib import Path
 from typing import Any
 
 import numpy as np
 import torch
 
-from .._stack import user_stacklevel
 from .. import _deprecate
 from .. import _validate as _v
-from ..datasets import file_sha256
-from ..io import IntegrityError
 from .data import Sequence, window_ends
 from .losses import LOSSES, TOTALS, qae, qmul, sample_loss, total_loss
 from .model import ACTIVATIONS, OrientationCNN
@@ -55,12 +47,6 @@ __all__ = [
     "closed_loop_estimate",
     "closed_loop_estimates",
     "run",
-    "save",
-    "load_model",
-    "load",
-    "sha256",
-    "read_sums",
-    "SUMS_FILE",
 ]
 
 
@@ -584,249 +570,5 @@ def closed_loop_estimates(
     return [_canonical(out).double().numpy() for out in outs]
 
 
-# ---------------------------------------------------------------- files
-
-
-def sha256(path: str | Path) -> str:
-    """SHA-256 of a file (hex), read once in 1 MiB blocks.
-
-    Parameters
-    ----------
-    path : str or pathlib.Path
-        File to hash.
-
-    Returns
-    -------
-    str
-        Hex digest (64 lower-case characters).
-    """
-    return file_sha256(path)
-
-
-#: Name of the checksum file of a model folder (``sha256sum`` format).
-SUMS_FILE = "SHA256SUMS"
-_SUMS_LINE = re.compile(r"([0-9A-Fa-f]{64}) ([ *])(.+)")
-
-
-def read_sums(path: str | Path) -> dict[str, str]:
-    """Parse a ``SHA256SUMS`` file (the format of ``sha256sum``): name -> sha256.
-
-    Each line is 64 hex digits, a space, then a space (text mode) or ``*`` (binary
-    mode), then the file name, relative to the file's folder. Blank lines are
-    ignored; anything else is an error.
-
-    Parameters
-    ----------
-    path : str or pathlib.Path
-        The ``SHA256SUMS`` file.
-
-    Returns
-    -------
-    dict
-        File name (str, relative to the file's folder) -> SHA-256 hex digest (str,
-        lower case).
-
-    Raises
-    ------
-    tiltlab.io.IntegrityError
-        (a ``ValueError`` and an ``OSError``) naming the file and the line: a
-        malformed line, a name listed twice, a name outside the folder (absolute, or
-        with ``..``), or no entry at all (an empty file); a missing or unreadable file.
-    """
-    path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise IntegrityError(
-            f"{path}: cannot read checksum file ({exc})", path=path
-        ) from None
-    out: dict[str, str] = {}
-    for number, line in enumerate(text.splitlines(), start=1):
-        if not line.strip():
-            continue
-        m = _SUMS_LINE.fullmatch(line)
-        if m is None:
-            shown = line if len(line) <= 80 else line[:77] + "..."
-            raise IntegrityError(
-                f"{path}, line {number}: malformed checksum line {shown!r}; expected "
-                "64 hex digits, two spaces (or a space and '*') and a file name",
-                path=path,
-            )
-        digest, _, name = m.groups()
-        parts = Path(name).parts
-        if Path(name).is_absolute() or ".." in parts or not parts:
-            raise IntegrityError(
-                f"{path}, line {number}: {name!r} is not a file name inside "
-                f"{path.parent}",
-                path=path,
-            )
-        if name in out:
-            raise IntegrityError(
-                f"{path}, line {number}: {name!r} is listed twice", path=path
-            )
-        out[name] = digest.lower()
-    if not out:
-        raise IntegrityError(
-            f"{path}: empty checksum file (no entries): nothing would be verified",
-            path=path,
-        )
-    return out
-
-
-def _state_digest(blob: dict[str, Any]) -> str:
-    """Hash what a model file holds with SHA-256.
-
-    SHA-256 of what a model file holds: configuration, ``fs`` and every tensor's
-    name, dtype, shape and bytes.
-    """
-    h = hashlib.sha256()
-    head = {"config": blob["config"], "fs": float(blob["fs"])}
-    h.update(json.dumps(head, sort_keys=True, default=str).encode() + b"\0")
-    for name in sorted(blob["state"]):
-        t = blob["state"][name]
-        if not torch.is_tensor(t):
-            h.update(json.dumps([name, repr(t)]).encode() + b"\0")
-            continue
-        t = t.detach().cpu().contiguous()
-        h.update(json.dumps([name, str(t.dtype), list(t.shape)]).encode() + b"\0")
-        h.update(t.reshape(-1).view(torch.uint8).numpy())
-    return h.hexdigest()
-
-
-def save(
-    model: OrientationCNN, config: TrainConfig, fs: float, path: str | Path
-) -> str:
-    """Write the weights (``path``, a ``.pt`` state dict) and return their sha256.
-
-    The file also holds the SHA-256 of its content (configuration, ``fs``, every
-    tensor), which :func:`load_model` checks; the returned sha256 of the whole file is the
-    one to list in the folder's ``SHA256SUMS`` (:func:`tiltlab.learn.cross_validate`
-    does).
-
-    Parameters
-    ----------
-    model : OrientationCNN
-        Network whose weights are written.
-    config : TrainConfig
-        Its training configuration, stored with the weights.
-    fs : float
-        Sampling rate (Hz) it was trained at.
-    path : str or pathlib.Path
-        Output ``.pt`` file (its folder is created if needed).
-
-    Returns
-    -------
-    str
-        SHA-256 hex digest of the written file.
-    """
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    blob = {"state": model.state_dict(), "config": config.to_dict(), "fs": float(fs)}
-    blob["sha256"] = _state_digest(blob)
-    torch.save(blob, path)
-    return sha256(path)
-
-
-def load_model(
-    path: str | Path, *, sha256: str | None = None, verify: bool = True
-) -> tuple[OrientationCNN, TrainConfig, float]:
-    """Read weights written by :func:`save`.
-
-    Gives the model (evaluation mode), its configuration and the sampling rate it was
-    trained at.
-    The file is checked first against its recorded sha256: ``sha256`` if given, else
-    its entry in ``SHA256SUMS`` beside it (the committed models, :func:`cross_validate`
-    folders); then against the digest of its content stored by :func:`save`. A file
-    with neither record (saved before they existed, alone) loads with a warning.
-
-    Parameters
-    ----------
-    path : path
-        A ``.pt`` file written by :func:`save`.
-    sha256 : str, optional
-        The expected SHA-256 of the whole file (hex).
-    verify : bool
-        Check the recorded checksums (default). ``verify=False`` loads a file that
-        fails them, e.g. to inspect it; never use such a model for results.
-
-    Returns
-    -------
-    model : OrientationCNN
-        The network, in evaluation mode.
-    config : TrainConfig
-        Its training configuration.
-    fs : float
-        Sampling rate (Hz) it was trained at.
-
-    Raises
-    ------
-    tiltlab.io.IntegrityError
-        (a ``ValueError``) naming the file: its sha256 differs from the recorded one,
-        its content from the digest saved in it, or ``SHA256SUMS`` is malformed.
-    """
-    path = Path(path)
-    expected, source = None, None
-    if verify:
-        if sha256 is not None:
-            expected, source = str(sha256).strip().lower(), "the expected sha256"
-        elif (path.parent / SUMS_FILE).is_file():
-            sums = read_sums(path.parent / SUMS_FILE)
-            if path.name in sums:
-                expected, source = sums[path.name], str(path.parent / SUMS_FILE)
-        if expected is not None:
-            got = _file_sha256(path)
-            if got != expected:
-                raise IntegrityError(
-                    f"{path}: model weights refused, sha256 {got} differs from "
-                    f"{source} ({expected}): the file is corrupt or was altered "
-                    "(load_model(path, verify=False) reads it anyway, to inspect it)",
-                    path=path,
-                )
-    try:
-        blob = torch.load(path, map_location="cpu", weights_only=True)
-    except FileNotFoundError:
-        raise
-    except Exception as exc:  # noqa: BLE001 - torch raises many types on damage
-        raise IntegrityError(
-            f"{path}: not a readable model file ({type(exc).__name__}: {exc})",
-            path=path,
-        ) from None
-    stored = blob.get("sha256") if isinstance(blob, dict) else None
-    if verify and stored is not None and _state_digest(blob) != stored:
-        raise IntegrityError(
-            f"{path}: model weights refused, their content differs from the sha256 "
-            "saved with them: the file is corrupt or was altered "
-            "(load_model(path, verify=False) reads it anyway, to inspect it)",
-            path=path,
-        )
-    if verify and stored is None and expected is None:
-        warnings.warn(
-            f"{path}: no recorded sha256 (no SHA256SUMS entry, saved before tiltlab "
-            "stored one): the weights are not checked",
-            stacklevel=user_stacklevel(),
-        )
-    cfg = TrainConfig.from_dict(blob["config"])
-    model = build_model(cfg, blob["fs"])
-    model.load_state_dict(blob["state"])
-    model.eval()
-    return model, cfg, float(blob["fs"])
-
-
-_file_sha256 = sha256  # ``load_model`` has a parameter of that name
-
 #: the old names, for one release
 run = _deprecate.alias(closed_loop_estimate, "run")
-load = _deprecate.alias(load_model, "load")
-
-
-def write_json(obj: Any, path: str | Path) -> None:
-    """Write ``obj`` as indented JSON with sorted keys and a final newline.
-
-    Parameters
-    ----------
-    obj : object
-        JSON-serialisable value.
-    path : str or pathlib.Path
-        File written.
-    """
-    Path(path).write_text(json.dumps(obj, indent=1, sort_keys=True) + "\n")
