@@ -120,10 +120,9 @@ class FeatureConfig:
         Orientation method of :func:`tiltlab.filters.estimate` (any name of
         :func:`tiltlab.filters.methods`). Default ``"smoother"``: the offline tilt
         smoother, following the filter benchmark chapter (offline methods are the most
-        accurate on BROAD and the right tool for post-hoc analysis; the low-pass of the
-        accelerometer, Fayat's choice with ``cutoff_hz=2.0``, is the least accurate on
-        simulated freely moving rats). Use ``method="lowpass",
-        method_params={"cutoff_hz": 2.0}`` to reproduce Fayat et al.
+        accurate on BROAD and the right tool for post-hoc analysis). Fayat et al.'s
+        cohort features use Madgwick's filter with their optimal gain β = 0.1 (their
+        Fig. 4b and Table 1): :meth:`fayat2021` sets it with their other definitions.
     method_params : dict
         Parameters of the method; completed with the registry's defaults on
         construction, so that the stored configuration names every value used.
@@ -161,6 +160,20 @@ class FeatureConfig:
         Vertices of the Fibonacci sphere mesh for the visited fraction (Fayat: 5000).
     visited_min_count : int
         Samples a facet needs to count as visited.
+    visited_by : {"area", "count"}
+        Fraction of the sphere visited as the visited facets' area over 4π
+        (``"area"``) or as their number over the number of facets (``"count"``, Fayat
+        et al.'s facet counting; the facets' areas differ by a few per cent).
+    tilt_mean : {"samples", "map"}
+        vMF mean tilt during immobility from the samples themselves (``"samples"``) or,
+        as Fayat et al. §2.8, from the facet centroids of the immobility tilt map
+        weighted by their sample counts (``"map"``; equal to within a facet's size).
+    sagittal : {"signed", "unsigned"}
+        ``tilt_immobile_sagittal_deg`` as the signed angle to the sagittal plane
+        (positive toward ``lesion_side``) or as Fayat et al.'s angular distance to it
+        (its absolute value, Fig. 4c and Tables A5–A6). The one-sided test of the
+        unsigned distance asks whether the head is tilted at all, not toward which
+        side.
     tilt_thresholds_deg : tuple of float
         Angles (deg) between the tilt and +z beyond which the head counts as tilted.
     speed_quantiles : tuple of float
@@ -188,6 +201,9 @@ class FeatureConfig:
     auto_threshold: bool = True
     mesh_n: int = 5000
     visited_min_count: int = 1
+    visited_by: str = "area"
+    tilt_mean: str = "samples"
+    sagittal: str = "signed"
     tilt_thresholds_deg: tuple = (20.0, 40.0)
     speed_quantiles: tuple = (0.5, 0.9)
     dba_window_s: float = 2.0
@@ -229,6 +245,9 @@ class FeatureConfig:
             "calibration_model": ("offsets", "ellipsoid"),
             "gyr_offset": ("auto", "none"),
             "lesion_side": ("left", "right"),
+            "visited_by": ("area", "count"),
+            "tilt_mean": ("samples", "map"),
+            "sagittal": ("signed", "unsigned"),
         }
         for f, allowed in choices.items():
             if getattr(self, f) not in allowed:
@@ -272,6 +291,54 @@ class FeatureConfig:
         if len(set(out)) != len(out):
             raise ValueError(f"FeatureConfig.{f} has repeated values: {v!r}")
         return tuple(sorted(out))
+
+    @classmethod
+    def fayat2021(cls, **changes: Any) -> "FeatureConfig":
+        """Return the configuration of Fayat et al. (2021)'s cohort features.
+
+        Madgwick's filter with their optimal gain β = 0.1 (their Table 1; the
+        fraction of the sphere visited of Fig. 4b is a "Madgwick estimate"), facets
+        counted on their 5000-vertex Fibonacci triangulation (§2.7), the vMF mean
+        tilt of the immobility tilt map from facet centroids weighted by counts
+        (§2.8), its unsigned angular distance to the sagittal plane (Fig. 4c), and
+        their immobility rules (12 °/s, 0.1 s, 0.5 s; §2.9). Everything else is the
+        default.
+
+        Parameters
+        ----------
+        **changes
+            Fields to set differently (e.g. ``lesion_side="right"``).
+
+        Returns
+        -------
+        FeatureConfig
+            The preset, validated like any configuration.
+
+        Examples
+        --------
+        >>> from tiltlab.cohort import FeatureConfig
+        >>> c = FeatureConfig.fayat2021()
+        >>> c.method, c.method_params["beta"], c.visited_by, c.sagittal
+        ('madgwick', 0.1, 'count', 'unsigned')
+
+        References
+        ----------
+        .. [1] R. Fayat et al., "Inertial Measurement of Head Tilt in Rodents:
+           Principles and Applications to Vestibular Research", Sensors 21(18):6318,
+           2021. doi:10.3390/s21186318
+        """
+        preset: dict[str, Any] = {
+            "method": "madgwick",
+            "method_params": {"beta": 0.1},
+            "mesh_n": 5000,
+            "visited_by": "count",
+            "tilt_mean": "map",
+            "sagittal": "unsigned",
+            "threshold_deg_s": 12.0,
+            "merge_gap_s": 0.1,
+            "min_duration_s": 0.5,
+        }
+        return cls(**(preset | changes))
 
     # ------------------------------------------------------------ serialisation
 

@@ -105,6 +105,7 @@ def feature_specs(config: FeatureConfig | None = None) -> dict[str, tuple[str, s
     """
     c = config or FeatureConfig()
     thr = f"{c.threshold_deg_s:g} deg/s"
+    what = "area" if c.visited_by == "area" else "facets"
     spec = {
         "n_samples": ("1", "number of samples analysed (samples in gaps left out)"),
         "duration_s": ("s", "duration of the recording"),
@@ -128,12 +129,12 @@ def feature_specs(config: FeatureConfig | None = None) -> dict[str, tuple[str, s
         ),
         "visited_fraction": (
             "1",
-            f"fraction of the sphere's area visited by the tilt (mesh of {c.mesh_n} "
-            "vertices), all samples",
+            f"fraction of the sphere's {what} visited by the tilt (mesh of "
+            f"{c.mesh_n} vertices), all samples",
         ),
         "visited_fraction_moving": (
             "1",
-            "fraction of the sphere's area visited by the tilt while moving",
+            f"fraction of the sphere's {what} visited by the tilt while moving",
         ),
         **_per_axis(
             "tilt_immobile", "1", "vMF mean tilt during immobility, sensor {} axis"
@@ -141,8 +142,10 @@ def feature_specs(config: FeatureConfig | None = None) -> dict[str, tuple[str, s
         "tilt_immobile_kappa": ("1", "vMF concentration of the tilt during immobility"),
         "tilt_immobile_sagittal_deg": (
             "deg",
-            f"angle of the mean immobile tilt to the sagittal plane, positive toward "
-            f"the {c.lesion_side} (lesion) side",
+            "angular distance of the mean immobile tilt to the sagittal plane"
+            if c.sagittal == "unsigned"
+            else f"angle of the mean immobile tilt to the sagittal plane, positive "
+            f"toward the {c.lesion_side} (lesion) side",
         ),
         "circling_index": (
             "1/min",
@@ -615,7 +618,7 @@ def _visited_features(acc: _Features, s: _Samples, config: FeatureConfig) -> Non
             continue
         tmap = _sphere.tilt_map(s.g[s.valid], mesh=mesh, mask=mask)
         acc.out[key] = _sphere.visited_fraction(
-            tmap, mesh, min_count=config.visited_min_count, by="area"
+            tmap, mesh, min_count=config.visited_min_count, by=config.visited_by
         )
 
 
@@ -626,12 +629,16 @@ def _tilt_immobile_features(acc: _Features, s: _Samples, config: FeatureConfig) 
     if s.imm.sum() < 2:
         acc.undefined(keys, f"fewer than 2 immobile samples ({int(s.imm.sum())})")
         return
-    fit = _sphere.vmf_fit(s.gv[s.imm])
+    if config.tilt_mean == "map":  # Fayat §2.8: facet centroids weighted by counts
+        tmap = _sphere.tilt_map(s.gv[s.imm], mesh=_sphere.sphere_mesh(config.mesh_n))
+        fit = _sphere.vmf_fit(tmap["centroid"].values, weights=tmap["count"].values)
+    else:
+        fit = _sphere.vmf_fit(s.gv[s.imm])
     acc.out.update({k: float(m) for k, m in zip(keys, fit.mu)})
     acc.out["tilt_immobile_kappa"] = float(fit.kappa)
-    acc.out["tilt_immobile_sagittal_deg"] = float(
-        np.degrees(_sphere.sagittal_angle(fit.mu, config.lesion_side))
-    )
+    angle = np.degrees(_sphere.sagittal_angle(fit.mu, config.lesion_side))
+    unsigned = config.sagittal == "unsigned"
+    acc.out["tilt_immobile_sagittal_deg"] = float(abs(angle) if unsigned else angle)
 
 
 def _motion_features(acc: _Features, s: _Samples, config: FeatureConfig) -> None:
