@@ -311,8 +311,32 @@ def check(nb_path: Path, params: dict) -> str:
             _check_simulation(nb_path, values),
             _check_rat(nb_path, params, values),
             _check_exercises(nb_path, values),
+            _check_c3d(nb_path, params),
         ]
     )
+
+
+def _check_c3d(nb_path: Path, params: dict) -> str:
+    """§5.5: the frames, rate and marker count printed for ``C3D_SOURCE`` are those
+    ``io.read_c3d`` reads (or the section said it skipped an absent file)."""
+    from tiltlab import io
+
+    source = params.get("C3D_SOURCE", "foreign:c3d_biomechzoo/HC030A05.c3d")
+    path = io.c3d_path(source)
+    if path is None or not path.is_file():
+        printed(nb_path, r"no such file; §5\.5 skipped", "§5.5 skip line")
+        return "§5.5 skipped (no C3D file)"
+    found = printed(
+        nb_path,
+        r"\((\d+) frames\) at ([0-9.]+) Hz, (\d+) markers",
+        "C3D summary line (§5.5)",
+    )
+    frames, fs, markers = found[0]
+    walk = io.read_c3d(path)
+    want = (walk.sizes["frame"], float(walk.attrs["fs"]), walk.sizes["marker"])
+    if (int(frames), float(fs), int(markers)) != want:
+        raise AssertionError(f"§5.5 printed {found[0]}, io.read_c3d reads {want}")
+    return f"C3D: {frames} frames at {fs} Hz, {markers} markers (as read)"
 
 
 def prepare_tag(tmp: Path) -> dict:

@@ -28,9 +28,12 @@ Submodules (all public names are re-exported here):
 * :mod:`~tiltlab.calibration.clocks` — lag by cross-correlation, TTL slip repair;
 * :mod:`~tiltlab.calibration.alignment` — head frame from markers, marker QC, Kabsch
   alignment, mounting rotation;
+* :mod:`~tiltlab.calibration.markers` — motion-capture marker gaps, short ones filled
+  by quadratic interpolation;
 * :mod:`~tiltlab.calibration.apply` — the :class:`Calibration` record and :func:`calibrate`.
 * :mod:`~tiltlab.calibration.summaries` — per-sample norm error, Allan noise table.
-* :mod:`~tiltlab.calibration.published` — LaCanna's drift tables (not re-exported here).
+* :mod:`~tiltlab.calibration.published` — LaCanna's Tables 2–6 and their summaries (not
+  re-exported here).
 """
 
 from ._util import CalibrationError
@@ -46,6 +49,8 @@ from .drift import *  # noqa: F401,F403
 from .drift import __all__ as _d
 from .magnetometer import *  # noqa: F401,F403
 from .magnetometer import __all__ as _f
+from .markers import *  # noqa: F401,F403
+from .markers import __all__ as _m
 from .orientations import *  # noqa: F401,F403
 from .orientations import __all__ as _o
 from .static import *  # noqa: F401,F403
@@ -55,4 +60,4 @@ from .summaries import __all__ as _s
 from .temperature import *  # noqa: F401,F403
 from .temperature import __all__ as _h
 
-__all__ = ["CalibrationError", *_a, *_e, *_b, *_c, *_d, *_f, *_o, *_g, *_h, *_s]
+__all__ = ["CalibrationError", *_a, *_e, *_b, *_c, *_d, *_f, *_o, *_g, *_h, *_s, *_m]

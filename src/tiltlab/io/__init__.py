@@ -27,6 +27,9 @@ Supported formats
   and verified on load (:class:`IntegrityError` on a mismatch, ``verify=False`` to
   salvage; ``netcdf_checksums`` reads them); ``open_netcdf`` opens any NetCDF-4 or
   NetCDF-3 file as stored.
+* C3D motion-capture exports (``read_c3d``): marker trajectories as a Dataset
+  (``markers`` frame × marker × axis, NaN where not reconstructed), computed channels
+  kept apart; ``c3d_path`` resolves ``"foreign:REL"`` in the data mirror.
 """
 
 from __future__ import annotations
@@ -34,6 +37,7 @@ from __future__ import annotations
 from .._stack import user_stacklevel
 from ._common import IntegrityError, ReadError
 from .broad import read_broad
+from .c3d import c3d_path, read_c3d
 from .check import try_read
 from .csv import (
     FS_RANGE,
@@ -66,6 +70,8 @@ __all__ = [
     "read_fayat_imu",
     "read_fayat_tumble",
     "read_broad",
+    "read_c3d",
+    "c3d_path",
     "read_csv",
     "read_csv_mapping",
     "CsvMapping",
