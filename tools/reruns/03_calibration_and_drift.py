@@ -62,8 +62,31 @@ def check(nb_path: Path, params: dict) -> str:
     notes = _summary_checks(nb_path, values, rec, intervals)
     return (
         f"{len(intervals)} still periods, first-pass gyro offset "
-        f"{np.round(expected, 2).tolist()} deg/s (package agrees); {notes}"
+        f"{np.round(expected, 2).tolist()} deg/s (package agrees); {notes}; "
+        f"{_check_lacanna(values)}"
     )
+
+
+def _check_lacanna(values: dict) -> str:
+    """LaCanna's sections: the combined drift correction ends where the linear fit
+    does (a least-squares slope is linear in the data) and starts below the prior
+    alone; Table 6's summary is reproduced; the per-axis complementary filter agrees
+    with the quaternion one."""
+    end_c = glued_float(values, "ch3_comb_combined_end")
+    end_l = glued_float(values, "ch3_comb_linear_fit_end")
+    if abs(end_c - end_l) > 1e-9 * max(1.0, abs(end_l)):
+        raise AssertionError(f"combined correction ends at {end_c}, linear fit {end_l}")
+    if not glued_float(values, "ch3_comb_combined_early") < glued_float(
+        values, "ch3_comb_prior_early"
+    ):
+        raise AssertionError("the combined correction is not below the prior early on")
+    verdict = values.get("ch3_t6_verdict", "").strip()
+    if verdict != "reproduce":
+        raise AssertionError(f"Table 6 verdict {verdict!r}, expected 'reproduce'")
+    gap = glued_float(values, "ch3_cf_gap")
+    if not gap < 0.5:
+        raise AssertionError(f"complementary filters differ by {gap} deg")
+    return f"LaCanna: combined = linear fit at the end, Table 6 reproduced, gap {gap:.2g} deg"
 
 
 def prepare_tag(tmp: Path) -> dict:

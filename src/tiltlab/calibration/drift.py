@@ -11,6 +11,9 @@ compared three corrections:
    (post-processing only);
 3. ``"prior"`` — a slope measured in an earlier calibration run is removed.
 
+His Discussion proposes combining the prior with a linear fit of the drift left over the
+run; ``"combined"`` implements it in real time (see :func:`correct_drift`).
+
 Drift arithmetic: a rate error of :math:`\epsilon` °/s accumulates
 :math:`3600\,\epsilon` ° per hour (:func:`deg_per_hour`; LaCanna: 0.9539 °/s →
 3434 °/h, 0.004718 °/s → 16.99 °/h).
@@ -34,6 +37,7 @@ import dataclasses
 from typing import NamedTuple
 
 import numpy as np
+import pandas as pd
 import xarray as xr
 
 from .. import _validate as _v
@@ -43,14 +47,17 @@ __all__ = [
     "deg_per_hour",
     "integrate_rate",
     "drift_slope",
+    "running_slope",
+    "hold_changes",
     "DriftCorrection",
     "correct_drift",
+    "drift_error_table",
     "allan_deviation",
     "AllanNoise",
     "allan_noise_parameters",
 ]
 
-_METHODS = ("first_window", "linear_fit", "prior", "none")
+_METHODS = ("first_window", "linear_fit", "prior", "combined", "none")
 
 
 def deg_per_hour(rate_deg_s) -> np.ndarray:
@@ -158,6 +165,83 @@ def drift_slope(
     return _slope(s.values, s.fs, start_s, stop_s)
 
 
+def _running_slope(th: np.ndarray, fs: float) -> np.ndarray:
+    # least-squares slope (with intercept) of th[0..k] against t for every k; NaN at k=0
+    n = np.arange(1, th.shape[0] + 1, dtype=float)[:, None]
+    t = (np.arange(th.shape[0]) / fs)[:, None]
+    st, stt = np.cumsum(t, axis=0), np.cumsum(t * t, axis=0)
+    sr, str_ = np.cumsum(th, axis=0), np.cumsum(t * th, axis=0)
+    den = n * stt - st * st
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.where(den > 0, (n * str_ - st * sr) / den, np.nan)
+
+
+def running_slope(angle, fs: float | None = None) -> np.ndarray:
+    r"""Least-squares slope of an integrated angle over ``[0, t_k]``, for every sample k.
+
+    The expanding-window fit a real-time system can compute at each sample (cumulative
+    sums, one pass): :math:`\hat s_k = (n S_{tr} - S_t S_r)/(n S_{tt} - S_t^2)` with the
+    sums over samples ``0..k`` (``n = k + 1``). At the last sample it equals
+    :func:`drift_slope` over the whole record.
+
+    Parameters
+    ----------
+    angle : DataArray or array_like (N, 3)
+        Integrated angle (e.g. :func:`integrate_rate`, in °).
+    fs : float, optional
+        Sampling rate (Hz); read from the attrs of labelled input, mandatory for a
+        plain array.
+
+    Returns
+    -------
+    ndarray (N, 3)
+        Slope in the angle's unit per second; NaN at the first sample (one point has
+        no slope).
+    """
+    s = _read_angle(angle, fs)
+    return _running_slope(s.values, s.fs)
+
+
+def hold_changes(angle, fs: float | None = None, *, holds) -> np.ndarray:
+    """Change of the mean angle between consecutive still holds (a rotation test).
+
+    LaCanna (2018) rotated the sensor by 1 rad and read the "height" of the integrated
+    angle after each rotation (his Table 5). Here each hold's angle is its mean over the
+    hold, and the change is the difference between consecutive holds.
+
+    Parameters
+    ----------
+    angle : DataArray or array_like (N, 3)
+        Integrated (drift-corrected) angle, e.g. :func:`correct_drift`'s ``angle`` (°).
+    fs : float, optional
+        Sampling rate (Hz), read as by :func:`drift_slope` (only checked here: the holds
+        are in samples).
+    holds : array_like of int, shape (K, 2)
+        Half-open sample intervals ``[start, stop)`` of the holds, in time order,
+        ``K >= 2``.
+
+    Returns
+    -------
+    ndarray (K - 1, 3)
+        Mean angle of hold ``k + 1`` minus that of hold ``k``, in the angle's unit.
+    """
+    s = _read_angle(angle, fs)
+    h = np.asarray(holds)
+    if h.ndim != 2 or h.shape[1] != 2 or h.shape[0] < 2:
+        raise ValueError(f"holds must have shape (K, 2) with K >= 2, got {h.shape}")
+    if not np.issubdtype(h.dtype, np.integer):
+        raise ValueError("holds must hold integer sample indices")
+    n = s.values.shape[0]
+    if np.any(h[:, 0] < 0) or np.any(h[:, 1] > n) or np.any(h[:, 1] <= h[:, 0]):
+        raise ValueError(
+            f"holds must be non-empty intervals [start, stop) within the {n} samples"
+        )
+    if np.any(h[1:, 0] < h[:-1, 1]):
+        raise ValueError("holds must be in time order and must not overlap")
+    means = np.array([s.values[a:b].mean(axis=0) for a, b in h])
+    return np.diff(means, axis=0)
+
+
 class DriftCorrection(NamedTuple):
     """Result of :func:`correct_drift`.
 
@@ -179,26 +263,59 @@ def correct_drift(
     prior_deg_s=None,
     units: str | None = None,
 ) -> DriftCorrection:
-    """Integrate a gyroscope and remove a linear drift by one of LaCanna's three methods.
+    r"""Integrate a gyroscope and remove a linear drift by one of LaCanna's methods.
+
+    ``"first_window"``, ``"linear_fit"`` and ``"prior"`` remove one slope
+    :math:`s` from the integrated angle, :math:`\theta_k - t_k s`. ``"combined"`` is the
+    combination LaCanna's Discussion proposes (a prior calibration, then a linear fit of
+    the drift left over the run), done in real time: the prior :math:`p` is removed, and
+    once ``window_s`` of data are in, the slope :math:`\hat r_k` of a least-squares line
+    fitted to the residual :math:`\theta - t\,p` over ``[0, t_k]``
+    (:func:`running_slope`) is removed too,
+
+    .. math:: \theta^{c}_k = \theta_k - t_k\,p - t_k\,\hat r_k \quad (t_k \ge
+              \text{window\_s}), \qquad \theta^{c}_k = \theta_k - t_k\,p
+              \quad\text{before}.
+
+    Each corrected sample uses only data up to it. A least-squares slope is linear in
+    the data, so :math:`p + \hat r_k` is the running slope of :math:`\theta` itself:
+    the prior matters only before ``window_s``, and the last sample equals the
+    ``"linear_fit"`` result (a whole-record post-processed combination would equal the
+    linear fit everywhere). A drift that is exactly linear is removed exactly from
+    ``window_s`` on, whatever the prior.
 
     Parameters
     ----------
     gyr, fs
         Angular velocity and sampling rate (Hz), read as by :func:`integrate_rate`,
         which integrates them.
-    method : {"first_window", "linear_fit", "prior", "none"}
-        See the module docstring.
+    method : {"first_window", "linear_fit", "prior", "combined", "none"}
+        See the module docstring and above.
     window_s : float
-        Length of the initial still window for ``"first_window"`` (s).
+        Length of the initial still window for ``"first_window"``, and the data needed
+        before ``"combined"`` trusts its running fit (s).
     prior_deg_s : array_like (3,)
-        Drift rate (°/s) from an earlier calibration, for ``"prior"``.
+        Drift rate (°/s) from an earlier calibration, for ``"prior"`` and
+        ``"combined"``.
     units : str, optional
         Units of a plain-array ``gyr`` (default °/s), as in :func:`integrate_rate`.
 
     Returns
     -------
     DriftCorrection
-        The corrected integrated angle (°), the removed slope (°/s) and the method.
+        The corrected integrated angle (°), the removed slope (°/s; for
+        ``"combined"`` the slope removed at the last sample) and the method.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from tiltlab import calibration
+    >>> gyr = np.tile([0.3, -0.9, 0.8], (2500, 1))  # a static gyroscope, deg/s
+    >>> c = calibration.correct_drift(
+    ...     gyr, 25.0, method="combined", prior_deg_s=[0.25, -0.95, 0.8]
+    ... )
+    >>> np.round(c.slope, 6).tolist(), float(np.abs(c.angle[-1]).max()) < 1e-9
+    ([0.3, -0.9, 0.8], True)
     """
     s, _ = read_in(gyr, "gyr", "deg/s", fs=fs, units=units)
     g, fs = s.values, s.fs
@@ -206,6 +323,9 @@ def correct_drift(
         raise ValueError(f"method must be one of {', '.join(_METHODS)}; got {method!r}")
     window_s = _v.positive(window_s, "window_s")
     th = _integrate(g, fs)
+    t = np.arange(g.shape[0])[:, None] / fs
+    if method == "combined":
+        return _combined(th, t, s, fs, window_s, prior_deg_s)
     if method == "none":
         slope = np.zeros(3)
     elif method == "first_window":
@@ -218,15 +338,85 @@ def correct_drift(
     elif method == "linear_fit":
         slope = _slope(th, fs, 0.0, None)
     else:  # "prior"
-        if prior_deg_s is None:
-            raise ValueError(
-                "method 'prior' needs prior_deg_s, the drift rate (°/s) from an earlier "
-                "calibration"
-            )
-        slope = vec3(prior_deg_s, "prior_deg_s", ndim=1)
-    t = np.arange(g.shape[0])[:, None] / fs
+        slope = _prior(prior_deg_s, method)
     angle = _v.labelled(th - t * slope, s, "angle", units="deg")
     return DriftCorrection(angle, np.asarray(slope, float), method)
+
+
+def _prior(prior_deg_s, method: str) -> np.ndarray:
+    if prior_deg_s is None:
+        raise ValueError(
+            f"method {method!r} needs prior_deg_s, the drift rate (°/s) from an earlier "
+            "calibration"
+        )
+    return vec3(prior_deg_s, "prior_deg_s", ndim=1)
+
+
+def _combined(th, t, s, fs, window_s, prior_deg_s) -> DriftCorrection:
+    # prior removed, then the running least-squares slope of the residual once
+    # window_s of data are in (real time: sample k uses samples 0..k only)
+    prior = _prior(prior_deg_s, "combined")
+    k0 = int(round(window_s * fs))
+    if k0 >= th.shape[0]:
+        raise CalibrationError(
+            f"the record ({th.shape[0] / fs:.1f} s) is shorter than window_s = "
+            f"{window_s:g} s, after which the combined method fits the residual drift"
+        )
+    resid = th - t * prior
+    r = _running_slope(resid, fs)
+    r[: max(k0, 1)] = 0.0
+    angle = _v.labelled(resid - t * r, s, "angle", units="deg")
+    return DriftCorrection(angle, prior + r[-1], "combined")
+
+
+def drift_error_table(angles, fs: float, *, at_s=(60.0, 600.0)) -> pd.DataFrame:
+    """Tabulate the angle left by drift corrections of a static record (the truth is 0).
+
+    Parameters
+    ----------
+    angles : mapping str → array_like (N, 3)
+        Corrected integrated angles (°) by method name, e.g. the ``angle`` of
+        :func:`correct_drift`; all of the same length.
+    fs : float
+        Sampling rate (Hz).
+    at_s : sequence of float
+        Times (s from the first sample) at which the error is read, within the record.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per method: the largest |angle| over the axes at each time in ``at_s``
+        and at the last sample, the largest over the record, and the RMS over samples
+        and axes (°); ``units`` and ``long_name`` in ``attrs``.
+    """
+    fs = _v.positive(fs, "fs")
+    if not angles:
+        raise ValueError("angles must name at least one corrected angle")
+    arrs = {k: vec3(v, f"angles[{k!r}]", ndim=2) for k, v in angles.items()}
+    n = {a.shape[0] for a in arrs.values()}
+    if len(n) != 1:
+        raise ValueError(f"angles must all have the same length, got {sorted(n)}")
+    n = n.pop()
+    idx = [int(round(t * fs)) for t in at_s]
+    if any(i < 0 or i >= n for i in idx):
+        raise ValueError(f"at_s must lie within the record (0 to {(n - 1) / fs:g} s)")
+    cols = [f"at {t:g} s" for t in at_s] + ["at end", "max", "rms"]
+    rows = {
+        k: [*(np.abs(a[i]).max() for i in idx), np.abs(a[-1]).max(), np.abs(a).max()]
+        + [float(np.sqrt(np.mean(a * a)))]
+        for k, a in arrs.items()
+    }
+    df = pd.DataFrame.from_dict(rows, orient="index", columns=cols).rename_axis(
+        "method"
+    )
+    long = [f"largest |angle| over the axes {c}" for c in cols[:-2]]
+    df.attrs = {
+        "units": dict.fromkeys(cols, "deg"),
+        "long_name": dict(
+            zip(cols, [*long, "largest |angle| over the record", "RMS angle"])
+        ),
+    }
+    return df
 
 
 def allan_deviation(

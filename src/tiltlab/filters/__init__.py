@@ -202,7 +202,7 @@ from .adapters import (
     run_riann,
     run_vqf,
 )
-from .complementary import complementary
+from .complementary import complementary, complementary_angles
 from .ekf import EkfTuning, ekf
 from .eskf import EskfTuning, eskf
 from .lowpass import lowpass_tilt
@@ -254,6 +254,7 @@ __all__ = [
     "tilt_quaternion",
     "lowpass_tilt",
     "complementary",
+    "complementary_angles",
     "madgwick",
     "madgwick_batch",
     "mahony",

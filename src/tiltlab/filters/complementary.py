@@ -1,4 +1,13 @@
-r"""Geometric complementary filter (6D or 9D), in the spirit of Valenti et al. (2015)."""
+r"""Complementary filters: geometric (6D or 9D, after Valenti et al. 2015) and per-axis.
+
+:func:`complementary` corrects a quaternion towards the accelerometer's vertical (and
+the magnetometer's north) by a fraction :math:`1 - e^{-\Delta t/\tau}` per sample.
+:func:`complementary_angles` is the per-axis form LaCanna (2018) writes down (his
+Introduction) — roll and pitch angles, each
+:math:`\alpha_i = a(\alpha_{i-1} + \omega_i\Delta t) + (1 - a)\,\alpha^{acc}_i` —
+valid for small tilts about one axis at a time; with :math:`a = e^{-\Delta t/\tau}` it
+is the single-axis case of the geometric filter.
+"""
 
 from __future__ import annotations
 
@@ -8,9 +17,10 @@ from numba import njit
 from .. import _validate as _v
 from ..quaternion import qmul_scalar, rotate_scalar, zoh_step_scalar
 from ._common import read_sensors, start_orientation
+from ._complementary_angles_kernel import complementary_angles_kernel
 from ._docs import shared_docs
 
-__all__ = ["complementary"]
+__all__ = ["complementary", "complementary_angles"]
 
 
 @njit(cache=True, nogil=True)
@@ -94,3 +104,65 @@ def complementary(
     out = np.empty((acc.shape[0], 4))
     _complementary_kernel(acc, gyr, m, use_mag, dt, k_acc, k_mag, q0, out)
     return out
+
+
+@shared_docs
+def complementary_angles(
+    acc, gyr, fs: float | None = None, *, a: float | None = None, tau_s: float = 1.0
+) -> np.ndarray:
+    r"""Estimate roll and pitch with LaCanna's per-axis complementary filter.
+
+    For each of roll (about x) and pitch (about y),
+
+    .. math:: \alpha_i = a\,(\alpha_{i-1} + \omega_i\,\Delta t) + (1 - a)\,
+              \alpha^{acc}_i,
+
+    with :math:`\omega` the gyroscope's x (roll) or y (pitch) rate,
+    :math:`\alpha^{acc}` the accelerometer's angle (roll ``atan2(a_y, a_z)``, pitch
+    ``atan2(-a_x, sqrt(a_y² + a_z²))``) and :math:`\alpha_0 = \alpha^{acc}_0`.
+    Unrolled, :math:`\alpha_i = a^i\alpha_0 + \sum_{j=1}^{i} a^{i-j+1}\omega_j\Delta t
+    + (1-a)\sum_{j=1}^{i} a^{i-j}\alpha^{acc}_j`: the accelerometer angle is
+    low-passed by a first-order filter whose impulse response decays as
+    :math:`a^{n} = e^{-n\Delta t/\tau}` for :math:`a = e^{-\Delta t/\tau}`, i.e. time
+    constant :math:`\tau = -\Delta t/\ln a \approx \Delta t/(1-a)`; ``a = 1``
+    integrates the gyroscope, ``a = 0`` returns the accelerometer angles. Adding a
+    gyroscope rate to a fixed axis is exact only for rotations about one axis
+    (small tilts otherwise); :func:`complementary` is the 3-D version, with the same
+    gain :math:`1-a` per sample.
+
+    Parameters
+    ----------
+    %(acc_gyr)s
+    %(fs)s
+    a : float, optional
+        Weight of the gyroscope path, ``0 <= a <= 1`` (LaCanna: 0.9 to 1); overrides
+        ``tau_s``.
+    tau_s : float
+        Time constant (s) giving ``a = exp(-1 / (fs tau_s))`` when ``a`` is not given;
+        ``inf`` gives ``a = 1``.
+
+    Returns
+    -------
+    numpy.ndarray, shape (N, 2)
+        Roll and pitch (°).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from tiltlab.filters.complementary import complementary_angles
+    >>> acc = np.tile([0.0, 0.5, np.sqrt(3) / 2], (50, 1))  # 30 deg roll, at rest
+    >>> np.round(complementary_angles(acc, np.zeros((50, 3)), 25.0)[-1], 6).tolist()
+    [30.0, 0.0]
+    """
+    fs, acc, gyr, _, _ = read_sensors(fs, acc, gyr)
+    dt = 1.0 / fs
+    if a is None:
+        tau_s = _v.positive(tau_s, "tau_s", allow_inf=True)
+        a = float(np.exp(-dt / tau_s))
+    else:
+        a = float(a)
+        if not 0.0 <= a <= 1.0:
+            raise ValueError(f"a must lie in [0, 1], got {a!r}")
+    out = np.empty((acc.shape[0], 2))
+    complementary_angles_kernel(acc, gyr, dt, a, out)
+    return np.degrees(out)

@@ -65,6 +65,7 @@ from .cohort import (
     simulate_cohort,
 )
 from .track import Track, simulate_heave, simulate_track
+from .turntable import TurntableMotion, back_and_forth, radian_test
 import tiltlab.simulate.cohort as _cohort
 import tiltlab.simulate.export as _export
 import tiltlab.simulate.kinematics as _kinematics
@@ -72,6 +73,7 @@ import tiltlab.simulate.mocap as _mocap
 import tiltlab.simulate.sensor as _sensor
 import tiltlab.simulate.track as _track
 import tiltlab.simulate.tumble as _tumble
+import tiltlab.simulate.turntable as _turntable
 
 __all__ = [
     *_kinematics.__all__,
@@ -81,4 +83,5 @@ __all__ = [
     *_mocap.__all__,
     *_cohort.__all__,
     *_track.__all__,
+    *_turntable.__all__,
 ]
