@@ -16,6 +16,10 @@ Submodules
   stationarity check (Benhamou 2023, §7);
 * :mod:`~tiltlab.sphere.residence` — residence time and number of visits
   (Benhamou 2023, App. C);
+* :mod:`~tiltlab.sphere.brb` — movement-based KDE with biased random bridges, weighted by
+  time, residence or visits, and residence maps on a KDE grid (Benhamou 2023, §7);
+* :mod:`~tiltlab.sphere.turns` — kernel densities of changes of heading (arc direction
+  and size on the sphere, direction on the circle);
 * :mod:`~tiltlab.sphere.text` — directions as printed text.
 
 Everything is re-exported here: ``from tiltlab import sphere; sphere.tilt_map(g)``.
@@ -73,6 +77,15 @@ from .kde import (
     slerp_vectors,
     stationarity_thirds,
 )
+from .brb import (
+    ResidenceMap,
+    brb,
+    brb_diffusion,
+    bridge_bandwidth,
+    kde_distance,
+    residence_map,
+)
+from .turns import circular_kde, heading_change_kde, heading_change_vectors
 from .tiltpoint import (
     mean_tilt_point,
     rotate_to_pole,
@@ -129,4 +142,13 @@ __all__ = [
     "residence",
     "residence_series",
     "format_direction",
+    "ResidenceMap",
+    "brb",
+    "brb_diffusion",
+    "bridge_bandwidth",
+    "residence_map",
+    "kde_distance",
+    "circular_kde",
+    "heading_change_kde",
+    "heading_change_vectors",
 ]

@@ -356,7 +356,9 @@ def mkde(
     weight :math:`\Delta t_k/m_k`, so the density is the fraction of *time* spent near
     each direction. With ``diffusion`` :math:`D` > 0 (rad²/s) the bandwidth grows inside
     the step like a Brownian bridge, :math:`h^2(\alpha) = h^2 + \alpha(1-\alpha)D\Delta
-    t_k` — a simplified, unbiased version of Benhamou's biased random bridges [3]_.
+    t_k` — a simplified, unbiased version of Benhamou's biased random bridges [3]_
+    (:func:`tiltlab.sphere.brb` has the bridges with a minimal width, a fitted D and
+    residence or visit weightings).
 
     At most 5·10⁷ kernels are placed (beyond that, an error names ``step``). Two
     successive samples in opposite directions are an error naming them (the arc

@@ -137,6 +137,8 @@ from .anchors import anchor_steps, dead_reckon_every
 from .arcs import *  # noqa: F401,F403
 from .arcs import __all__ as _arcs
 from .deadreckoning import *  # noqa: F401,F403
+from .flight import *  # noqa: F401,F403
+from .flight import __all__ as _flight
 from .deadreckoning import __all__ as _dr
 from .heading import *  # noqa: F401,F403
 from .heading import __all__ as _heading
@@ -167,6 +169,7 @@ __all__ = [
     "anchor_steps",
     "dead_reckon_every",
     *_osc,
+    *_flight,
     # result types
     "Orientation",
     "Posture",
