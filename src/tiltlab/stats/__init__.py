@@ -20,9 +20,11 @@ One implementation each:
   for a user-supplied simulator (this package never imports :mod:`tiltlab.simulate`);
 * :mod:`~tiltlab.stats.design` — :func:`study_design`: groups, control, time points,
   baseline, test directions and families read from a cohort table (:class:`StudyDesign`);
+* :mod:`~tiltlab.stats.cells` — :func:`long_table`, :func:`check_cells`: the sessions
+  of each group × time point of a cohort table, one animal per cell;
 * :mod:`~tiltlab.stats.tables` — :func:`between_groups`, :func:`against_baseline`
-  (tidy tables from a cohort Dataset/DataFrame) and :func:`format_table` (Tables
-  A1–A8 layout);
+  (tidy tables from a cohort Dataset/DataFrame, with the Bonferroni family stated) and
+  :func:`format_table` (Tables A1–A8 layout);
 * :mod:`~tiltlab.stats.summaries` — :func:`group_quantiles`, :func:`significant_cells`,
   :func:`with_published` (our p-values next to the printed Tables A1–A2) and
   :func:`recovery_table` (planted versus estimated differences of a simulated cohort).
@@ -34,6 +36,7 @@ Example
 0.1875
 """
 
+from .cells import check_cells, long_table
 from .design import StudyDesign, design_tables, session_table, study_design
 from .effects import (
     Interval,
@@ -49,6 +52,7 @@ from .multiple import (
     FAYAT_FAMILIES,
     add_adjustments,
     adjust,
+    family_caption,
     paper_bonferroni,
 )
 from .nonparametric import (
@@ -68,6 +72,7 @@ from .permutation import permutation_interaction
 from .published import (
     FAYAT_DESIGN,
     FAYAT_FEATURE_TABLES,
+    FAYAT_GROUP_SIZES,
     FAYAT_TABLES,
     FAYAT_TIME_POINTS,
     fayat_table,
@@ -86,17 +91,17 @@ from .summaries import (
     recovery_table,
     significant_cells,
     with_published,
+    published_agreement,
 )
 from .tables import (
     COLOURS,
     THRESHOLDS,
     against_baseline,
     between_groups,
-    check_cells,
     format_table,
-    long_table,
 )
 
+from .cells import __all__ as _cells_all
 from .design import __all__ as _design_all
 from .effects import __all__ as _effects_all
 from .mixed import __all__ as _mixed_all
@@ -117,6 +122,7 @@ __all__ = [
     *_mixed_all,
     *_permutation_all,
     *_power_all,
+    *_cells_all,
     *_tables_all,
     *_summaries_all,
 ]

@@ -357,6 +357,9 @@ def design_tables(
     design: StudyDesign,
     *,
     conf_level: float = 0.95,
+    family_size: int | None = None,
+    baseline_family_size: int | None = None,
+    **test_options,
 ) -> tuple[pd.DataFrame, pd.DataFrame | None]:
     """Compute the rank-test tables of one feature under a design.
 
@@ -376,6 +379,16 @@ def design_tables(
         From :func:`study_design`.
     conf_level : float
         Level of the effect-size intervals.
+    family_size : int, optional
+        Bonferroni family size of each between-group family (default: the number of
+        cells tested in it); stated in the table (``family_size`` column,
+        :func:`~tiltlab.stats.family_caption`).
+    baseline_family_size : int, optional
+        The same for each group's tests against baseline.
+    **test_options
+        Passed to both tests, e.g. ``method="paper"`` (exact without ties,
+        tie-corrected normal approximation with ties, per cell; see
+        :func:`~tiltlab.stats.between_groups`).
 
     Returns
     -------
@@ -396,6 +409,8 @@ def design_tables(
             timepoints=design.compared_timepoints,
             baseline=design.baseline or "",
             conf_level=conf_level,
+            family_size=family_size,
+            **test_options,
         )
         part.insert(0, "family", name)
         parts.append(part)
@@ -411,5 +426,7 @@ def design_tables(
             alternative=alt,
             timepoints=design.compared_timepoints,
             conf_level=conf_level,
+            family_size=baseline_family_size,
+            **test_options,
         )
     return between, within

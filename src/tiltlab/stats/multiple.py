@@ -18,7 +18,11 @@ Four adjustments of the p-values :math:`p_1..p_m` of one family of :math:`m` tes
 
 The family size :math:`m` defaults to the number of p-values given; a larger ``family``
 treats the missing tests as having :math:`p = 1` (for Bonferroni/Holm/BH this is the
-usual correction for :math:`m` tests of which only some are shown).
+usual correction for :math:`m` tests of which only some are shown). In a table
+(:func:`add_adjustments`), the default family is the *tested* cells, so it shrinks
+when some cells cannot be tested (18 → 16 with two empty cells); ``family_size``
+states :math:`m` instead, and every table records the family it used and how many of
+its cells were tested (``attrs["families"]``, :func:`family_caption`).
 
 Fayat et al.'s families (inferred from Tables A1–A8)
 ----------------------------------------------------
@@ -55,6 +59,7 @@ References
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Sequence
 
 import numpy as np
@@ -63,6 +68,7 @@ from statsmodels.stats.multitest import multipletests
 
 from .. import _validate
 from .._labels import label_columns
+from .._stack import user_stacklevel
 
 __all__ = [
     "ADJUSTMENTS",
@@ -70,6 +76,7 @@ __all__ = [
     "adjust",
     "paper_bonferroni",
     "add_adjustments",
+    "family_caption",
 ]
 
 #: Adjustment names and their statsmodels methods ("paper" is ours).
@@ -169,20 +176,114 @@ ADDED_COLUMNS = {
 }
 
 
-def _family_keys(table: pd.DataFrame, family) -> tuple[list[np.ndarray], int | None]:
-    """Row-index groups forming the families, and a fixed multiplier (or None)."""
+def _family_keys(
+    table: pd.DataFrame, family
+) -> tuple[dict[str, np.ndarray], int | None]:
+    """Row-index groups forming the families (by label), and a fixed multiplier."""
     if family is None or isinstance(family, (int, np.integer)):
-        return [np.arange(len(table))], (None if family is None else int(family))
+        return {"all": np.arange(len(table))}, (None if family is None else int(family))
     cols = [family] if isinstance(family, str) else list(family)
     missing = [c for c in cols if c not in table.columns]
     if missing:
         raise ValueError(f"family names unknown column(s) {missing}")
     groups = table.reset_index(drop=True).groupby(cols, sort=False).indices
-    return [np.asarray(v) for v in groups.values()], None
+
+    def label(key) -> str:
+        return " / ".join(map(str, key)) if isinstance(key, tuple) else str(key)
+
+    return {label(k): np.asarray(v) for k, v in groups.items()}, None
+
+
+def _family_size(family_size, fixed: int | None) -> int | None:
+    """Check ``family_size`` against an integer ``family``; return the multiplier."""
+    if family_size is None:
+        return fixed
+    m = _validate.integer(family_size, "family_size", minimum=1)
+    if fixed is not None and fixed != m:
+        raise ValueError(
+            f"family_size ({m}) and the integer family ({fixed}) disagree; give one"
+        )
+    return m
+
+
+def family_caption(table: pd.DataFrame) -> str:
+    r"""Say which Bonferroni family a tidy table used, and how many cells were tested.
+
+    Parameters
+    ----------
+    table : pandas.DataFrame
+        From :func:`add_adjustments` (or :func:`~tiltlab.stats.between_groups`,
+        :func:`~tiltlab.stats.against_baseline`): read from ``attrs["families"]``
+        when they describe its rows, else from the ``family_size`` and ``p`` columns
+        (one family per value of a ``family`` column, as in
+        :func:`~tiltlab.stats.design_tables`).
+
+    Returns
+    -------
+    str
+        E.g. ``"Bonferroni family: m = 18 (16 of 18 cells tested)"``; one clause per
+        family when they differ; ``""`` when the table says nothing about it.
+
+    Examples
+    --------
+    >>> import pandas as pd
+    >>> family_caption(add_adjustments(pd.DataFrame({"p": [0.01, 0.2]})))
+    'Bonferroni family: m = 2 (2 of 2 cells tested)'
+    """
+    fams = table.attrs.get("families")
+    by = table.attrs.get("family_by", "family")
+    usable = isinstance(fams, dict) and fams
+    if not usable or sum(f["n_cells"] for f in fams.values()) != len(table):
+        fams, by = _families_from_columns(table), "family"  # e.g. attrs lost in concat
+        if not fams:
+            return ""
+
+    def clause(f: dict) -> str:
+        return (
+            f"m = {f['family_size']} ({f['n_tested']} of {f['n_cells']} cells tested)"
+        )
+
+    items = list(fams.values())
+    if len(items) == 1:
+        return f"Bonferroni family: {clause(items[0])}"
+    if len({(f["family_size"], f["n_tested"], f["n_cells"]) for f in items}) == 1:
+        each = (
+            "Bonferroni families, each"
+            if by == "family"
+            else f"Bonferroni family per {by}"
+        )
+        return f"{each}: {clause(items[0])}"
+    return "Bonferroni families: " + "; ".join(
+        f"{name}: {clause(f)}" for name, f in fams.items()
+    )
+
+
+def _families_from_columns(table: pd.DataFrame) -> dict[str, dict]:
+    """Rebuild ``attrs["families"]`` from the ``family_size`` and ``p`` columns."""
+    if "family_size" not in table.columns or "p" not in table.columns:
+        return {}
+    parts = (
+        table.groupby("family", sort=False)
+        if "family" in table.columns
+        else [("all", table)]
+    )
+    out = {}
+    for name, part in parts:
+        sizes = sorted({int(v) for v in part["family_size"].dropna()})
+        if sizes:
+            out[str(name)] = {
+                "family_size": " or ".join(map(str, sizes)),
+                "n_tested": int(np.isfinite(part["p"].to_numpy(dtype=float)).sum()),
+                "n_cells": len(part),
+            }
+    return out
 
 
 def add_adjustments(
-    table: pd.DataFrame, family: int | str | Sequence[str] | None = None
+    table: pd.DataFrame,
+    family: int | str | Sequence[str] | None = None,
+    *,
+    family_size: int | None = None,
 ) -> pd.DataFrame:
     r"""Add ``family_size``, ``p_paper``, ``p_bonferroni``, ``p_holm``, ``p_bh``.
 
@@ -191,33 +292,90 @@ def add_adjustments(
     table : pandas.DataFrame
         A tidy test table with a ``p`` column (NaN for cells that were not tested).
     family : int, str, sequence of str or None
-        ``None``: all tested rows form one family (:math:`m` = their number);
-        a column name or names: one family per distinct value (e.g. ``"group1"`` for
-        the baseline tables); an int: the fixed multiplier :math:`m` for every row
-        (Holm and BH then treat the table as one family of :math:`m` tests).
+        ``None``: all rows form one family; a column name or names: one family per
+        distinct value (e.g. ``"group1"`` for the baseline tables); an int: the
+        fixed multiplier :math:`m` for every row (Holm and BH then treat the table
+        as one family of :math:`m` tests).
+    family_size : int, optional
+        The number of tests :math:`m` of every family, stated explicitly (e.g. 18
+        for Fayat et al.'s between-group tables, 6 against baseline,
+        :data:`FAYAT_FAMILIES`). Default: the family's *tested* rows — so a family
+        silently shrinks when some cells cannot be tested; with ``family_size`` the
+        untested cells count as :math:`p = 1` and a family whose tested count
+        differs from ``family_size`` is reported by a warning.
 
     Returns
     -------
     pandas.DataFrame
         A copy with the five columns added (dimensionless, with their long names in
         ``attrs["long_name"]``; the p-value columns have role ``"p-value"``).
+        ``attrs["families"]`` maps each family (``"all"`` when the whole table is
+        one) to its ``family_size``, ``n_tested`` and ``n_cells``;
+        ``attrs["family_size"]`` is the multiplier (an int when every family has the
+        same one, else a dict family → m); ``attrs["family_by"]`` the grouping;
+        ``attrs["family_caption"]`` says it in words (:func:`family_caption`).
+
+    Raises
+    ------
+    ValueError
+        ``family_size`` below 1, smaller than the tested rows of a family, or
+        disagreeing with an integer ``family``.
+
+    Warns
+    -----
+    RuntimeWarning
+        ``family_size`` larger than the tested rows of a family (untested cells).
     """
     out = table.copy().reset_index(drop=True)
     p = out["p"].to_numpy(dtype=float)
     cols = {k: np.full(len(out), np.nan) for k in ("paper", "bonferroni", "holm", "bh")}
     size = np.full(len(out), np.nan)
     groups, fixed = _family_keys(out, family)
-    for idx in groups:
-        idx = idx[np.isfinite(p[idx])]
+    fixed = _family_size(family_size, fixed)
+    families, short = {}, []
+    for name, rows in groups.items():
+        idx = rows[np.isfinite(p[rows])]
+        m = fixed if fixed is not None else idx.size
+        families[name] = {
+            "family_size": int(m),
+            "n_tested": int(idx.size),
+            "n_cells": int(rows.size),
+        }
+        if family_size is not None and idx.size > m:
+            raise ValueError(
+                f"family_size ({m}) is smaller than the {idx.size} tested cells of "
+                f"family {name!r}"
+            )
+        if family_size is not None and idx.size < m:
+            short.append(f"{name!r}: {idx.size} of {rows.size} cells")
         if idx.size == 0:
             continue
-        m = fixed if fixed is not None else idx.size
         size[idx] = m
         for k in cols:
             cols[k][idx] = adjust(p[idx], k, family=m)
+    if short:
+        warnings.warn(
+            f"family_size = {fixed} but fewer cells were tested in family "
+            f"{'; '.join(short)}; the untested ones count as p = 1 (Bonferroni over "
+            f"{fixed} tests)",
+            RuntimeWarning,
+            stacklevel=user_stacklevel(),
+        )
     out["family_size"] = size
     for k, v in cols.items():
         out[f"p_{k}"] = v
+    ms = {f["family_size"] for f in families.values()}
+    by = "table" if family is None or isinstance(family, (int, np.integer)) else family
+    out.attrs.update(
+        families=families,
+        family_by=by if isinstance(by, str) else " / ".join(map(str, by)),
+        family_size=(
+            ms.pop()
+            if len(ms) == 1
+            else {k: f["family_size"] for k, f in families.items()}
+        ),
+    )
+    out.attrs["family_caption"] = family_caption(out)
     return label_columns(
         out,
         units=dict.fromkeys(ADDED_COLUMNS, "1"),

@@ -50,6 +50,22 @@ continuity correction of 1/2:
 and for :math:`T^+`, :math:`\mu = n(n+1)/4`, :math:`\sigma^2 = n(n+1)(2n+1)/24 -
 \sum_g (t_g^3 - t_g)/48` (:math:`t_g`: sizes of the tie groups).
 
+The paper's practice (``method="paper"``)
+-----------------------------------------
+Fayat et al.'s tables mix exact and asymptotic p-values: where the two samples have
+no ties their values sit on the exact lattice :math:`k/\binom{N}{n_1}`, but two cells
+of their Table A3 (ShamArsanilate vs Healthy, 16.592 at 1 d and 13.204 at 7 d) sit on
+no exact lattice of groups of at most 5 and 11 animals — with or without ties, every
+permutation p-value is a multiple of :math:`1/\binom{N}{n_1}`; they would need more
+animals than the paper allocated — and equal the tie-corrected, continuity-corrected
+normal approximation with one tied pair across the groups. That is the rule of ``scipy.stats.mannwhitneyu(method="auto")`` (exact when one
+sample has at most 8 values and there are no ties, asymptotic otherwise).
+``method="paper"`` reproduces it per test: exact when there are no ties (and, for the
+signed-rank test, no zero differences) within the ``exact_max_n`` rule of ``"auto"``,
+the tie-corrected normal approximation otherwise; ``TestResult.method`` records which
+one each test used. (``scipy.stats.wilcoxon``'s normal approximation has no continuity
+correction by default: ``continuity=False`` matches it.)
+
 References
 ----------
 .. [1] H. B. Mann and D. R. Whitney, "On a test of whether one of two random variables
@@ -96,7 +112,7 @@ __all__ = [
 ALTERNATIVES = ("greater", "less", "two-sided")
 #: Zero-difference rules of the signed-rank test.
 ZERO_METHODS = ("wilcox", "pratt")
-_METHODS = ("auto", "exact", "asymptotic")
+_METHODS = ("auto", "exact", "asymptotic", "paper")
 #: Most non-zero differences of an exact signed-rank test (2^n must fit a float64).
 EXACT_MAX_PAIRS = 1000
 #: Most cells of the subset-sum array of an exact Mann–Whitney test (160 MB).
@@ -362,14 +378,17 @@ def mann_whitney(
     alternative : {"greater", "less", "two-sided"}
         ``"greater"``: values of ``x`` tend to exceed those of ``y``
         (:math:`P(X > Y) > 1/2`). No default: the direction must be stated.
-    method : {"auto", "exact", "asymptotic"}
+    method : {"auto", "exact", "asymptotic", "paper"}
         ``"auto"`` is exact when :math:`\min(n_1, n_2) \le` ``exact_max_n`` (exact
-        conditional on the ties when there are ties), asymptotic otherwise. Beyond the
-        exact range (:data:`EXACT_MAX_CELLS`, see the module docstring) an exact
-        request gives the asymptotic p-value, with ``method`` and ``note`` saying so.
+        conditional on the ties when there are ties), asymptotic otherwise.
+        ``"paper"`` is ``"auto"`` except that tied samples get the tie-corrected
+        normal approximation instead of the exact conditional p-value (Fayat et al.'s
+        practice, see the module docstring). Beyond the exact range
+        (:data:`EXACT_MAX_CELLS`, see the module docstring) an exact request gives the
+        asymptotic p-value, with ``method`` and ``note`` saying so.
     exact_max_n : int
-        Threshold of ``"auto"`` (8, scipy's rule, which reproduces the p-value
-        lattice of Fayat et al.'s Tables A1–A7 for the 5-animal group).
+        Threshold of ``"auto"`` and ``"paper"`` (8, scipy's rule, which reproduces
+        the p-value lattice of Fayat et al.'s Tables A1–A7 for the 5-animal group).
     continuity : bool
         Continuity correction of the asymptotic p-value.
 
@@ -411,8 +430,9 @@ def mann_whitney(
     u = r1 - n1 * (n1 + 1) / 2.0
     ties = bool(np.unique(ranks).size < ranks.size)
     requested, note = method, ""
-    if method == "auto":
-        method = "exact" if min(n1, n2) <= exact_max_n else "asymptotic"
+    if method in ("auto", "paper"):
+        small = min(n1, n2) <= exact_max_n
+        method = "exact" if small and not (ties and method == "paper") else "asymptotic"
     if method == "exact":
         w = np.rint(2 * ranks).astype(np.int64) if ties else np.arange(1, n1 + n2 + 1)
         direct = _mwu_cells(w, n1)
@@ -478,13 +498,15 @@ def wilcoxon_signed_rank(
         Zero differences: ``"wilcox"`` drops them before ranking (Wilcoxon 1945, R's
         ``wilcox.test``, scipy's default); ``"pratt"`` ranks them with the others and
         then drops them (Pratt 1959).
-    method : {"auto", "exact", "asymptotic"}
+    method : {"auto", "exact", "asymptotic", "paper"}
         ``"auto"`` is exact for :math:`n \le` ``exact_max_n`` non-zero differences
-        (exact conditional with ties or zeros), asymptotic otherwise. Beyond
+        (exact conditional with ties or zeros), asymptotic otherwise. ``"paper"`` is
+        ``"auto"`` except that tied ranks or zero differences get the tie-corrected
+        normal approximation (see the module docstring). Beyond
         :data:`EXACT_MAX_PAIRS` (1000) non-zero differences an exact request gives the
         asymptotic p-value, with ``method`` and ``note`` saying so.
     exact_max_n : int
-        Threshold of ``"auto"`` (50, as scipy and R).
+        Threshold of ``"auto"`` and ``"paper"`` (50, as scipy and R).
     continuity : bool
         Continuity correction of the asymptotic p-value.
 
@@ -546,8 +568,9 @@ def wilcoxon_signed_rank(
     t_plus = float(ranks[dn > 0].sum())
     ties = bool(np.unique(ranks).size < ranks.size)
     requested, note = method, ""
-    if method == "auto":
-        method = "exact" if n <= exact_max_n else "asymptotic"
+    if method in ("auto", "paper"):
+        plain = not (ties or n_zero) or method == "auto"
+        method = "exact" if n <= exact_max_n and plain else "asymptotic"
     if method == "exact" and n > EXACT_MAX_PAIRS:
         method = "asymptotic"
         note = _beyond_exact(

@@ -18,7 +18,13 @@ from .._labels import label_columns
 from .effects import hodges_lehmann
 from .tables import format_table, long_table
 
-__all__ = ["group_quantiles", "significant_cells", "with_published", "recovery_table"]
+__all__ = [
+    "group_quantiles",
+    "significant_cells",
+    "with_published",
+    "published_agreement",
+    "recovery_table",
+]
 
 _TIDY = ("comparison", "timepoint")
 
@@ -142,6 +148,90 @@ def with_published(tidy: pd.DataFrame, printed: pd.DataFrame | None = None):
         long_name={c: f"p, {c}" for c in table.columns},
         role="p-value",
     )
+
+
+def _printed_value(cell) -> float:
+    """Read a printed m·p cell as a number (``"<0.001"`` becomes half its bound)."""
+    text = str(cell).strip()
+    if not text:
+        return np.nan
+    if text.startswith("<"):
+        return float(text[1:]) / 2
+    return float(text)
+
+
+def published_agreement(
+    tidy: pd.DataFrame, printed: pd.DataFrame, *, alpha: float = 0.05
+) -> pd.DataFrame:
+    r"""Set each cell's Bonferroni decision beside a printed table's, cell by cell.
+
+    A cell is significant when its uncapped :math:`m\,p` is below ``alpha`` (Fayat et
+    al.'s convention; a printed ``"<0.001"`` counts as below any ``alpha`` above
+    0.001).
+
+    Parameters
+    ----------
+    tidy : pandas.DataFrame
+        From :func:`~tiltlab.stats.between_groups` or
+        :func:`~tiltlab.stats.against_baseline` (``comparison``, ``timepoint``,
+        ``p_paper``).
+    printed : pandas.DataFrame
+        A printed table, comparisons × time points as strings
+        (:func:`~tiltlab.stats.fayat_table`).
+    alpha : float
+        Family-wise level.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per cell both tables hold: ``comparison``, ``timepoint``,
+        ``printed`` (as printed), ``ours`` (our :math:`m\,p`),
+        ``printed_significant``, ``ours_significant`` and ``agree``.
+
+    Raises
+    ------
+    ValueError
+        If the two tables share no cell, or ``alpha`` is not in (0, 1).
+
+    Examples
+    --------
+    >>> import pandas as pd
+    >>> tidy = pd.DataFrame({"comparison": ["A vs. B"] * 2, "timepoint": ["1h", "1d"],
+    ...                      "p_paper": [0.01, 0.4]})
+    >>> printed = pd.DataFrame({"1h": ["<0.001"], "1d": ["0.020"]}, index=["A vs. B"])
+    >>> published_agreement(tidy, printed)["agree"].tolist()
+    [True, False]
+    """
+    if not 0 < alpha < 1:
+        raise ValueError(f"alpha must be in (0, 1), got {alpha!r}")
+    _need(tidy, ("comparison", "timepoint", "p_paper"), "tidy")
+    rows = []
+    for _, r in tidy.iterrows():
+        c, t = r["comparison"], r["timepoint"]
+        if c not in printed.index or t not in printed.columns:
+            continue
+        value = _printed_value(printed.loc[c, t])
+        ours = float(r["p_paper"])
+        if np.isnan(value) or np.isnan(ours):
+            continue
+        rows.append(
+            {
+                "comparison": c,
+                "timepoint": t,
+                "printed": str(printed.loc[c, t]),
+                "ours": ours,
+                "printed_significant": bool(value < alpha),
+                "ours_significant": bool(ours < alpha),
+            }
+        )
+    if not rows:
+        raise ValueError(
+            "the tidy table and the printed table share no cell (compare their "
+            "comparison labels and time points)"
+        )
+    out = pd.DataFrame(rows)
+    out["agree"] = out["printed_significant"] == out["ours_significant"]
+    return out
 
 
 _RECOVERY = {

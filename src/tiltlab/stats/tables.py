@@ -38,6 +38,13 @@ conf_level, note``
   (time point − baseline). Intervals are two-sided at ``conf_level``.
 * A cell that cannot be tested (a group without enough values) keeps NaN values and
   says why in ``note``.
+* ``method`` records the p-value method of each cell (``"exact"``,
+  ``"exact-conditional"``, ``"asymptotic-cc"``…); ``method="paper"`` reproduces Fayat
+  et al.'s mix (exact without ties, the normal approximation with ties).
+* The Bonferroni family travels with the table: ``attrs["family_size"]`` (the
+  multiplier), ``attrs["families"]`` (each family's ``family_size``, ``n_tested``,
+  ``n_cells``) and ``attrs["family_caption"]``; ``family_size=`` states :math:`m`
+  explicitly instead of counting the tested cells.
 
 References
 ----------
@@ -47,27 +54,31 @@ References
 
 from __future__ import annotations
 
-import re
 from collections.abc import Mapping, Sequence
 
 import numpy as np
 import pandas as pd
-import xarray as xr
 
 from .. import _validate
 from .._labels import format_p, label_columns
+from .cells import (  # _timepoint_key, long_table: re-exported for design, summaries
+    _feature_units,
+    _frame,
+    _ordered_timepoints,
+    _timepoint_key,  # noqa: F401
+    check_cells,
+    long_table,  # noqa: F401
+)
 from .effects import (
     hodges_lehmann,
     paired_prob_superiority,
     paired_rank_biserial,
     prob_superiority,
 )
-from .multiple import ADDED_COLUMNS, add_adjustments
+from .multiple import ADDED_COLUMNS, add_adjustments, family_caption
 from .nonparametric import _alternative, mann_whitney, wilcoxon_signed_rank
 
 __all__ = [
-    "long_table",
-    "check_cells",
     "between_groups",
     "against_baseline",
     "format_table",
@@ -78,168 +89,6 @@ __all__ = [
 #: Highlight thresholds of Tables A1–A8 and their colours (yellow, green, blue).
 THRESHOLDS = (0.05, 0.01, 0.001)
 COLOURS = ("#fff176", "#a5d6a7", "#90caf9")
-
-_DURATION = re.compile(r"^\s*([-+]?\d+(?:\.\d+)?)\s*(min|h|d|w)\s*$", re.IGNORECASE)
-_UNIT_HOURS = {"min": 1 / 60, "h": 1.0, "d": 24.0, "w": 168.0}
-
-
-def _frame(features, feature: str) -> pd.DataFrame:
-    """Return every session of a cohort table as a frame.
-
-    Columns ``session`` (None when the table has no ids), ``subject``,
-    ``group``, ``timepoint``, ``value`` and ``status`` (``"ok"`` when absent).
-    """
-    need = ("subject", "group", "timepoint")
-    if isinstance(features, xr.Dataset):
-        if "session" not in features.dims:
-            raise ValueError("features must have a 'session' dimension")
-        if feature not in features.data_vars:
-            raise ValueError(
-                f"feature {feature!r} is not a variable of features "
-                f"(variables: {sorted(map(str, features.data_vars))})"
-            )
-        if features[feature].dims != ("session",):
-            raise ValueError(f"feature {feature!r} must have dims ('session',)")
-        missing = [c for c in need if c not in features.variables]
-        if missing:
-            raise ValueError(f"features lacks coordinate(s) {missing}")
-        cols = {c: features[c].values for c in need}
-        cols["value"] = features[feature].values
-        cols["status"] = (
-            features["status"].values.astype(str)
-            if "status" in features.variables
-            else "ok"
-        )
-        cols["session"] = (
-            features["session"].values.astype(str)
-            if "session" in features.variables
-            else None
-        )
-        df = pd.DataFrame(cols)
-    elif isinstance(features, pd.DataFrame):
-        missing = [c for c in (*need, feature) if c not in features.columns]
-        if missing:
-            raise ValueError(f"features lacks column(s) {missing}")
-        df = features[list(need)].copy()
-        df["value"] = features[feature].to_numpy()
-        df["status"] = (
-            features["status"].astype(str).to_numpy()
-            if "status" in features.columns
-            else "ok"
-        )
-        df["session"] = (
-            features["session"].astype(str).to_numpy()
-            if "session" in features.columns
-            else None
-        )
-    else:
-        raise ValueError(
-            f"features must be an xarray.Dataset or a pandas.DataFrame, got "
-            f"{type(features).__name__}"
-        )
-    df["value"] = pd.to_numeric(df["value"], errors="coerce").astype(float)
-    return df.reset_index(drop=True)
-
-
-def check_cells(table: pd.DataFrame, what: str = "features") -> None:
-    """Refuse a cohort table with two sessions of one subject at one time point.
-
-    Each animal is one experimental unit: two sessions of it in one cell would count
-    it twice (pseudo-replication) in a between-group test, and cannot be paired with
-    its baseline. Every session counts, failed ones included.
-
-    Parameters
-    ----------
-    table : pandas.DataFrame
-        With ``subject`` and ``timepoint`` columns, and ``session`` ids as a column or
-        as the index (named ``session``) when available.
-    what : str
-        The table's name in the message.
-
-    Raises
-    ------
-    ValueError
-        Naming each duplicated (subject, time point) and its sessions (or rows).
-    """
-    df = table.reset_index() if table.index.name == "session" else table
-    dup = df.duplicated(["subject", "timepoint"], keep=False)
-    if not dup.any():
-        return
-    cells = []
-    for (subject, tp), rows in df[dup].groupby(
-        ["subject", "timepoint"], sort=False, dropna=False
-    ):
-        if "session" in rows.columns and rows["session"].notna().all():
-            which = "sessions " + ", ".join(map(repr, rows["session"].astype(str)))
-        else:
-            which = "rows " + ", ".join(str(i) for i in rows.index)
-        cells.append(f"subject {subject!r} at {tp!r} ({which})")
-    shown = "; ".join(cells[:5]) + (
-        f"; and {len(cells) - 5} more" if len(cells) > 5 else ""
-    )
-    raise ValueError(
-        f"{what} has more than one session of a subject at a time point: {shown}. "
-        "Each animal is one unit: counting it twice is pseudo-replication. Keep one "
-        "session per subject and time point (drop one, or average them into one row) "
-        "before testing"
-    )
-
-
-def long_table(features, feature: str, *, include_failed: bool = False) -> pd.DataFrame:
-    """One row per usable session: ``subject``, ``group``, ``timepoint``, ``value``.
-
-    Parameters
-    ----------
-    features : xarray.Dataset or pandas.DataFrame
-        The cohort table (see the module docstring).
-    feature : str
-        The feature variable / column.
-    include_failed : bool
-        Also return the sessions whose ``status`` is not ``"ok"`` (``value`` NaN
-        there), with a ``status`` column, e.g. to count them.
-
-    Returns
-    -------
-    pandas.DataFrame
-        Sessions with ``status == "ok"`` (when a status exists), or every session with
-        ``include_failed``; ``value`` may be NaN.
-    """
-    df = _frame(features, feature)
-    keep = ["subject", "group", "timepoint", "value"]
-    if include_failed:
-        df.loc[df["status"] != "ok", "value"] = np.nan
-        out = df[keep + ["status"]].reset_index(drop=True)
-    else:
-        out = df.loc[df["status"] == "ok", keep].reset_index(drop=True)
-    names = {"subject": "subject", "group": "group", "timepoint": "time point"}
-    names.update(value=feature, status="session status")
-    units = dict.fromkeys(out.columns, "")
-    units["value"] = _feature_units(features, feature)
-    return label_columns(out, units=units, long_name={c: names[c] for c in out.columns})
-
-
-def _timepoint_key(label) -> float:
-    if isinstance(label, (int, float, np.integer, np.floating)):
-        return float(label) * 24.0  # numbers are days
-    m = _DURATION.match(str(label))
-    if m:
-        return float(m.group(1)) * _UNIT_HOURS[m.group(2).lower()]
-    raise KeyError(label)
-
-
-def _ordered_timepoints(df: pd.DataFrame, baseline, timepoints) -> list:
-    present = list(dict.fromkeys(df["timepoint"]))
-    if timepoints is not None:
-        unknown = [t for t in timepoints if t not in present]
-        if unknown:
-            raise ValueError(f"timepoints {unknown} are not in the data ({present})")
-        return list(timepoints)
-    rest = [t for t in present if t != baseline]
-    try:
-        rest.sort(key=_timepoint_key)
-    except KeyError:
-        pass  # keep the order of appearance
-    return rest
 
 
 def _effects_row(x, y, conf_level, paired, zero_method="wilcox") -> dict:
@@ -299,36 +148,6 @@ TIDY_LONG_NAMES = {
 _HL = ("hl", "hl_low", "hl_high")
 
 
-def _feature_units(features, feature: str) -> str:
-    """Return the units of a feature of a cohort table (``""`` when not stated).
-
-    Parameters
-    ----------
-    features : xarray.Dataset or pandas.DataFrame
-        The cohort table: a Dataset variable's ``attrs["units"]``, or a DataFrame's
-        ``attrs["units"][feature]``.
-    feature : str
-        The feature.
-
-    Returns
-    -------
-    str
-        Its units, ``""`` when the table does not say.
-
-    Examples
-    --------
-    >>> import pandas as pd
-    >>> df = pd.DataFrame({"x": [1.0]})
-    >>> df.attrs["units"] = {"x": "deg"}
-    >>> _feature_units(df, "x"), _feature_units(df, "y")
-    ('deg', '')
-    """
-    if isinstance(features, xr.Dataset) and feature in features.variables:
-        return str(features[feature].attrs.get("units", ""))
-    units = getattr(features, "attrs", {}).get("units", {})
-    return str(units.get(feature, "")) if isinstance(units, Mapping) else ""
-
-
 def _label_tidy(table: pd.DataFrame, units: str = "") -> pd.DataFrame:
     """Return a tidy test table with the units and long names of its columns.
 
@@ -368,12 +187,14 @@ _COLUMNS = (
 ).split()
 
 
-def _finish(rows: list[dict], family, units: str = "") -> pd.DataFrame:
+def _finish(
+    rows: list[dict], family, units: str = "", family_size=None
+) -> pd.DataFrame:
     table = pd.DataFrame(rows)
     for c in _COLUMNS:
         if c not in table.columns:
             table[c] = np.nan
-    table = add_adjustments(table[_COLUMNS], family)
+    table = add_adjustments(table[_COLUMNS], family, family_size=family_size)
     front = _COLUMNS[: _COLUMNS.index("p") + 1]
     adj = ["family_size", "p_paper", "p_bonferroni", "p_holm", "p_bh"]
     return _label_tidy(table[front + adj + _COLUMNS[len(front) :]], units)
@@ -381,11 +202,11 @@ def _finish(rows: list[dict], family, units: str = "") -> pd.DataFrame:
 
 def _checked_options(conf_level, test_options) -> float:
     """Check the effect-size level and the test options; return the level."""
-    unknown = sorted(set(test_options) - {"method", "exact_max_n"})
+    unknown = sorted(set(test_options) - {"method", "exact_max_n", "continuity"})
     if unknown:
         raise TypeError(
-            f"unknown test option(s) {unknown}; the options are 'method' and "
-            "'exact_max_n'"
+            f"unknown test option(s) {unknown}; the options are 'method', "
+            "'exact_max_n' and 'continuity'"
         )
     return _validate.fraction(conf_level, "conf_level", open_low=True, open_high=True)
 
@@ -399,6 +220,7 @@ def between_groups(
     timepoints: Sequence | None = None,
     baseline: str = "baseline",
     family: int | str | Sequence[str] | None = None,
+    family_size: int | None = None,
     conf_level: float = 0.95,
     **test_options,
 ) -> pd.DataFrame:
@@ -423,12 +245,22 @@ def between_groups(
         The baseline label excluded by default.
     family : int, str, sequence of str or None
         Bonferroni family (:func:`tiltlab.stats.multiple.add_adjustments`): default
-        every tested cell of the table, i.e. 18 for Fayat et al.'s 3 comparisons × 6
-        time points per lesion type.
+        the whole table, i.e. Fayat et al.'s 3 comparisons × 6 time points per lesion
+        type.
+    family_size : int, optional
+        The number of tests :math:`m` of the family, stated: e.g. 18 for Fayat et
+        al.'s tables. Default: the tested cells (18 when all are testable, fewer —
+        silently — when some are not). With ``family_size``, untested cells count as
+        :math:`p = 1` and a :class:`RuntimeWarning` says how many were tested.
+        Either way ``attrs["family_size"]``, ``attrs["families"]`` and
+        ``attrs["family_caption"]`` state the family used and the cells tested.
     conf_level : float
         Level of the effect-size intervals.
     **test_options
-        ``method`` and ``exact_max_n`` of :func:`tiltlab.stats.mann_whitney`.
+        ``method`` (``"paper"`` for Fayat et al.'s mix of exact and asymptotic
+        p-values), ``exact_max_n`` and ``continuity`` of
+        :func:`tiltlab.stats.mann_whitney`; the ``method`` column records the method
+        of each cell.
 
     Returns
     -------
@@ -440,9 +272,15 @@ def between_groups(
     ------
     ValueError
         Two sessions of one subject at one time point (:func:`check_cells`), a group
-        absent from the data, a comparison without a direction.
+        absent from the data, a comparison without a direction, a ``family_size``
+        below the tested cells.
     TypeError
         An unknown test option.
+
+    Warns
+    -----
+    RuntimeWarning
+        ``family_size`` larger than the number of tested cells.
 
     Examples
     --------
@@ -527,7 +365,8 @@ def between_groups(
             row.update(statistic=res.statistic, method=res.method, p=res.p)
             row.update(_effects_row(x, y, conf_level, paired=False))
             rows.append(row)
-    return _finish(rows, family, _feature_units(features, feature))
+    units = _feature_units(features, feature)
+    return _finish(rows, family, units, family_size)
 
 
 def against_baseline(
@@ -539,6 +378,7 @@ def against_baseline(
     alternative: str | Mapping[str, str],
     timepoints: Sequence | None = None,
     family: int | str | Sequence[str] | None = "group1",
+    family_size: int | None = None,
     zero_method: str = "wilcox",
     conf_level: float = 0.95,
     **test_options,
@@ -565,12 +405,16 @@ def against_baseline(
     family : int, str, sequence of str or None
         Bonferroni family: default ``"group1"`` — each group's time points, i.e.
         Fayat et al.'s 6 (Tables A2, A4, A6, A8).
+    family_size : int, optional
+        The number of tests :math:`m` of each family, stated (6 in Fayat et al.'s
+        tables); default each family's tested cells (see :func:`between_groups`).
     zero_method : {"wilcox", "pratt"}
         Zero-difference rule (:func:`tiltlab.stats.wilcoxon_signed_rank`).
     conf_level : float
         Confidence level of the intervals around the effect sizes.
     **test_options
-        The signed-rank test's ``method`` and ``exact_max_n``
+        The signed-rank test's ``method`` (``"paper"``: exact without ties or zeros,
+        else the normal approximation), ``exact_max_n`` and ``continuity``
         (:func:`tiltlab.stats.wilcoxon_signed_rank`).
 
     Returns
@@ -585,7 +429,13 @@ def against_baseline(
     ------
     ValueError
         Two sessions of one subject at one time point (:func:`check_cells`), a group
-        or the baseline absent from the data, a group without a direction.
+        or the baseline absent from the data, a group without a direction, a
+        ``family_size`` below a family's tested cells.
+
+    Warns
+    -----
+    RuntimeWarning
+        ``family_size`` larger than the number of tested cells of a family.
     """
     conf_level = _checked_options(conf_level, test_options)
     full = _frame(features, feature)
@@ -666,7 +516,8 @@ def against_baseline(
                 _effects_row(x, y, conf_level, paired=True, zero_method=zero_method)
             )
             rows.append(row)
-    return _finish(rows, family, _feature_units(features, feature))
+    units = _feature_units(features, feature)
+    return _finish(rows, family, units, family_size)
 
 
 def _stars(v: float) -> str:
@@ -679,11 +530,15 @@ def format_table(
     *,
     output: str = "text",
     decimals: int = 3,
+    family_column: bool = False,
 ):
     r"""Lay a tidy table out like Fayat et al.'s Tables A1–A8.
 
     Rows are the comparisons, columns the time points (both in order of appearance);
-    values below :math:`10^{-3}` print as ``"<0.001"``, others with 3 decimals.
+    values below :math:`10^{-3}` print as ``"<0.001"``, others with 3 decimals. The
+    Bonferroni family travels with the table: a Styler's caption, and
+    ``attrs["caption"]`` of the other outputs, say which :math:`m` multiplied the
+    p-values and how many cells were tested (:func:`tiltlab.stats.family_caption`).
 
     Parameters
     ----------
@@ -698,10 +553,25 @@ def format_table(
         ``"frame"``: the numeric pivot.
     decimals : int
         Decimals shown.
+    family_column : bool
+        Add a last column ``"m"``: each row's family size, with ``"(k of n tested)"``
+        when some of its cells could not be tested.
 
     Returns
     -------
     pandas.DataFrame or pandas.io.formats.style.Styler
+
+    Examples
+    --------
+    >>> import pandas as pd
+    >>> tidy = pd.DataFrame({"comparison": ["a vs. b"] * 2, "timepoint": ["1d", "7d"],
+    ...                      "p": [0.002, float("nan")]})
+    >>> from tiltlab.stats import add_adjustments
+    >>> out = format_table(add_adjustments(tidy), family_column=True)
+    >>> out.loc["a vs. b"].tolist()
+    ['0.002**', '', '1 (1 of 2 tested)']
+    >>> out.attrs["caption"]
+    'Bonferroni family: m = 1 (1 of 2 cells tested)'
     """
     if output not in ("text", "styler", "frame"):
         raise ValueError(f"output must be 'text', 'styler' or 'frame', got {output!r}")
@@ -720,17 +590,28 @@ def format_table(
     ).reindex(index=rows, columns=cols)
     grid.index.name, grid.columns.name = None, None
     is_p = value == "p" or value.startswith("p_")
+    caption = family_caption(tidy)
+    m = _family_column(tidy, rows) if family_column else None
     if output == "frame":
         units = tidy.attrs.get("units", {})
-        return label_columns(
+        out = label_columns(
             grid,
             units="1" if is_p else str(units.get(value, "")),
             long_name={c: f"{TIDY_LONG_NAMES.get(value, value)}, {c}" for c in cols},
             role="p-value" if is_p else None,
         )
+        if m is not None:
+            out = label_columns(
+                out.assign(m=m), units={"m": ""}, long_name={"m": "family size m"}
+            )
+        out.attrs["caption"] = caption
+        return out
     text = grid.map(lambda v: format_p(v, decimals))
     if output == "text":
-        return text + grid.map(_stars) if is_p else text
+        out = text + grid.map(_stars) if is_p else text
+        out = out.assign(m=m) if m is not None else out
+        out.attrs["caption"] = caption
+        return out
 
     def colour(_):
         out = pd.DataFrame("", index=grid.index, columns=grid.columns)
@@ -739,4 +620,26 @@ def format_table(
                 out = out.mask(grid < t, f"background-color: {c}")
         return out
 
-    return text.style.apply(colour, axis=None)
+    shown = text.assign(m=m) if m is not None else text
+    styler = shown.style.apply(
+        lambda d: colour(d).reindex(columns=d.columns, fill_value=""), axis=None
+    )
+    return styler.set_caption(caption) if caption else styler
+
+
+def _family_column(tidy: pd.DataFrame, rows: list) -> pd.Series:
+    """Write each comparison's family size and, if some were not, its tested cells."""
+    if "family_size" not in tidy.columns or "p" not in tidy.columns:
+        raise ValueError("family_column needs the family_size and p columns of tidy")
+    whole = tidy.attrs.get("family_size")
+    out = {}
+    for name, cell in tidy.groupby("comparison", sort=False):
+        sizes = sorted({int(v) for v in cell["family_size"].dropna()})
+        if not sizes and isinstance(whole, (int, np.integer)):
+            sizes = [int(whole)]
+        tested = int(np.isfinite(cell["p"].to_numpy(dtype=float)).sum())
+        text = " or ".join(map(str, sizes))
+        if tested < len(cell):
+            text += f" ({tested} of {len(cell)} tested)"
+        out[name] = text
+    return pd.Series(out).reindex(rows)
