@@ -224,7 +224,36 @@ def check(nb_path: Path, params: dict) -> str:
         f"{tests} tests on {len(groups)} groups × {post} time points; "
         f"{subject} {timepoint} circling {index} /min (package: {circling:+.3f}); "
         + _check_summary(nb_path, params)
+        + "; "
+        + _check_paper_scale(nb_path)
     )
+
+
+PAPER = Path(__file__).resolve().parents[2] / "data" / "cohort_fayat2021"
+
+
+def _check_paper_scale(nb_path: Path) -> str:
+    """§11: the glued count of cells whose decision matches the printed Tables A1–A8,
+    recomputed from the committed paper-scale table with the paper's definitions."""
+    from tiltlab import cohort, stats
+
+    big = cohort.read_feature_archive(PAPER).features["fayat2021"]
+    d = stats.FAYAT_DESIGN
+    design = stats.study_design(
+        big, control=d["control"], families=d["families"], directions=d["directions"]
+    )
+    same = cells = 0
+    for feature, names in stats.FAYAT_FEATURE_TABLES.items():
+        tidy = stats.design_tables(
+            big, feature, design, method="paper", family_size=18, baseline_family_size=6
+        )
+        for name, t in zip(names, tidy):
+            a = stats.published_agreement(t, stats.fayat_table(name))
+            same, cells = same + int(a["agree"].sum()), cells + len(a)
+    sentence = glued(nb_path).get("ch8_scale_sentence", "")
+    if f"{same} of {cells} cells reach the same decision" not in sentence:
+        raise AssertionError(f"§11 says {sentence!r}; recomputed {same} of {cells}")
+    return f"paper scale: {same} of {cells} cells as printed"
 
 
 def prepare_foreign(tmp: Path) -> dict:

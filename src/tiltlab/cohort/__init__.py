@@ -23,6 +23,10 @@ r"""Cohorts: from a lab's folder of sessions to one feature table (layer 7).
   ``dask.distributed``, one code path; a per-session disk cache; failed sessions
   recorded, never lost), :func:`summary`, :func:`save_features`,
   :func:`load_features`;
+* :mod:`~tiltlab.cohort.archive` — :func:`read_feature_archive` (saved feature tables
+  of several configurations, each checked against its SHA-256);
+* :mod:`~tiltlab.cohort.trajectories` — :func:`tilt_trajectories` (Fig. 3e: each
+  animal's mean-tilt trajectory with its baseline at the pole, group mean directions);
 * :mod:`~tiltlab.cohort.tables` — the same feature table for R, Excel and pandas:
   :func:`to_table` (a tidy DataFrame, one row per session, ids as strings, units in
   ``df.attrs``), :func:`save_table` (``.csv`` with its units in the sidecar
@@ -78,6 +82,8 @@ from .run import (
     summary,
 )
 from .tables import TABLE_SUFFIXES, load_table, save_table, sidecar_path, to_table
+from .trajectories import pole_rotation, tilt_trajectories
+from .archive import FeatureArchive, read_feature_archive
 
 __all__ = [
     "FeatureConfig",
@@ -111,6 +117,10 @@ __all__ = [
     "summary",
     "save_features",
     "load_features",
+    "pole_rotation",
+    "FeatureArchive",
+    "read_feature_archive",
+    "tilt_trajectories",
     "TABLE_SUFFIXES",
     "to_table",
     "save_table",

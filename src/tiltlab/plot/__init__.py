@@ -15,7 +15,9 @@ Submodules
   grids of maps, residence maps ;
 * :mod:`~tiltlab.plot.scores` — estimator errors: parameter-grid heat maps and curves,
   per-trial bars, ECDFs, errors binned by speed;
-* :mod:`~tiltlab.plot.cohort` — Tukey boxplots and group means for cohort tables;
+* :mod:`~tiltlab.plot.cohort` — Tukey boxplots and group means for cohort tables, mean-tilt
+  trajectories with each baseline at the pole (Fig. 3e);
+* :mod:`~tiltlab.plot.movement` — changes of heading and flight classes;
 * :mod:`~tiltlab.plot.learning` — training curves and per-trial errors by method;
 * :mod:`~tiltlab.plot.tables` — :func:`table`, the table recipe: headers with units,
   rounding by quantity, p-values written once.
@@ -24,9 +26,10 @@ Everything is re-exported here: ``from tiltlab import plot; plot.kde_map(k)``.
 """
 
 from .calibration import mag_calibration_figure
-from .cohort import group_lines, tukey_boxplot
+from .cohort import group_lines, tilt_trajectories_figure, tukey_boxplot
 from .filters import estimates_overview, plain_log_ticks, running_rms, tilt_angle_deg
 from .learning import learning_curves, method_strips
+from .movement import flight_classes_figure, heading_change_figure
 from .mapfigures import (
     facet_map,
     kde_map,
@@ -72,6 +75,7 @@ from .filters import __all__ as _filters_all
 from .learning import __all__ as _learning_all
 from .mapfigures import __all__ as _mapfigures_all
 from .maps import __all__ as _maps_all
+from .movement import __all__ as _movement_all
 from .recording import __all__ as _recording_all
 from .scores import __all__ as _scores_all
 from .tables import __all__ as _tables_all
@@ -84,6 +88,7 @@ __all__ = [
     *_scores_all,
     *_cohort_all,
     *_learning_all,
+    *_movement_all,
     *_filters_all,
     *_tables_all,
 ]

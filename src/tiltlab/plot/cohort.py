@@ -16,7 +16,7 @@ import xarray as xr
 
 from ._common import Look, finish_axes, label, new_axes
 
-__all__ = ["tukey_boxplot", "group_lines"]
+__all__ = ["tukey_boxplot", "group_lines", "tilt_trajectories_figure"]
 
 
 def _table(data, value: str) -> tuple[pd.DataFrame, str | None]:
@@ -219,3 +219,125 @@ def group_lines(
     return finish_axes(
         ax, x, label(style.name or value, units), legend_title=hue, title=style.title
     )
+
+
+_RINGS_DEG = (2.0, 5.0, 10.0, 20.0, 30.0, 45.0, 60.0, 90.0)
+
+
+def _laea(p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Lambert azimuthal equal-area coordinates of unit vectors about +z."""
+    k = np.sqrt(2.0 / np.clip(1.0 + p[..., 2], 1e-12, None))
+    return k * p[..., 0], k * p[..., 1]
+
+
+def tilt_trajectories_figure(
+    trajectories: xr.Dataset,
+    *,
+    groups: Sequence[str] | None = None,
+    annotate: bool = True,
+):
+    r"""Draw mean-tilt trajectories with each baseline at the pole (Fayat Fig. 3e).
+
+    One panel per group, seen from above the pole in the Lambert azimuthal equal-area
+    projection (:math:`X = \sqrt{2/(1+z)}\,x`, :math:`Y = \sqrt{2/(1+z)}\,y`): each
+    animal's trajectory in grey, the group's mean direction in red with its time
+    first, last and farthest time points labelled, circles at constant angles from the
+    baseline.
+
+    Parameters
+    ----------
+    trajectories : xarray.Dataset
+        Output of :func:`tiltlab.cohort.tilt_trajectories`.
+    groups : sequence of str, optional
+        Panels, in order (default: every group of ``trajectories``).
+    annotate : bool
+        Label the group mean's first and last time points after baseline and the one
+        farthest from it.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure (one axes per group).
+
+    Raises
+    ------
+    ValueError
+        A group that ``trajectories`` does not hold.
+
+    Examples
+    --------
+    >>> import numpy as np, xarray as xr
+    >>> from tiltlab import cohort, plot
+    >>> mu = np.array([[0.0, 0.0, 1.0], [0.0, 0.2, 1.0], [0.1, 0.0, 1.0], [0.1, 0.1, 1.0]])
+    >>> ds = xr.Dataset(
+    ...     {f"tilt_immobile_{a}": ("session", mu[:, i]) for i, a in enumerate("xyz")},
+    ...     coords={"subject": ("session", ["r1", "r1", "r2", "r2"]),
+    ...             "group": ("session", ["A"] * 4),
+    ...             "timepoint": ("session", ["baseline", "1d"] * 2)})
+    >>> fig = plot.tilt_trajectories_figure(cohort.tilt_trajectories(ds))
+    >>> len(fig.axes)
+    1
+    """
+    import matplotlib.pyplot as plt
+
+    names = list(trajectories["group"].values)
+    groups = names if groups is None else [str(g) for g in groups]
+    unknown = [g for g in groups if g not in names]
+    if unknown:
+        raise ValueError(f"groups {unknown} are not in the trajectories: {names}")
+    largest = np.nanmax(
+        np.concatenate(
+            [
+                trajectories["angle"].values.ravel(),
+                trajectories["mean_angle"].values.ravel(),
+            ]
+        ),
+        initial=1.0,
+    )
+    rings = [r for r in _RINGS_DEG if r <= 1.05 * largest][-4:] or [_RINGS_DEG[0]]
+    edge = 1.15 * 2 * np.sin(np.radians(max(rings[-1], largest)) / 2)
+    fig, axes = plt.subplots(
+        1, len(groups), figsize=(3.2 * len(groups), 3.4), squeeze=False
+    )
+    t = np.linspace(0, 2 * np.pi, 200)
+    for ax, g in zip(axes[0], groups):
+        for r in rings:
+            rr = 2 * np.sin(np.radians(r) / 2)
+            ax.plot(rr * np.cos(t), rr * np.sin(t), color="0.85", lw=0.8, zorder=0)
+            ax.text(rr * 0.71, rr * 0.71, f"{r:g}°", color="0.5", fontsize=7)
+        mine = trajectories["animal_group"].values == g
+        for p in trajectories["point"].values[mine]:
+            x, y = _laea(p)
+            ax.plot(x, y, color="0.6", lw=0.8, alpha=0.8)
+        x, y = _laea(trajectories["mean"].sel(group=g).values)
+        ax.plot(x, y, color="tab:red", lw=2.2, marker="o", ms=3.5)
+        if annotate:  # the first and last time points after baseline, and the farthest
+            angles = trajectories["mean_angle"].sel(group=g).values
+            post = np.arange(1, len(angles))
+            keep = {1, len(angles) - 1}
+            if np.isfinite(angles[1:]).any():
+                keep.add(int(post[np.nanargmax(angles[1:])]))
+            for k, (xi, yi, tp) in enumerate(
+                zip(x, y, trajectories["timepoint"].values)
+            ):
+                if np.isfinite(xi) and k in keep:
+                    ax.annotate(
+                        str(tp),
+                        (xi, yi),
+                        xytext=(3, 3),
+                        textcoords="offset points",
+                        fontsize=7,
+                        color="tab:red",
+                    )
+        ax.plot([0], [0], marker="+", color="k", ms=8)
+        n = int(mine.sum())
+        ax.set_title(f"{g} (n = {n})", fontsize=10)
+        ax.set_xlim(-edge, edge)
+        ax.set_ylim(-edge, edge)
+        ax.set_aspect("equal")
+        ax.set_xticks([])
+        ax.set_yticks([])
+        ax.set_xlabel("nose (x) →", fontsize=8)
+        ax.set_ylabel("left (y) →", fontsize=8)
+    fig.tight_layout()
+    return fig
