@@ -42,7 +42,8 @@ Modules
 :mod:`~tiltlab.evaluate.selection` (grid search over methods' parameters, LOTO),
 :mod:`~tiltlab.evaluate.recipes` (a grid's best parameters, methods as estimators,
 the tilt difference between two methods, errors pooled over recordings),
-:mod:`~tiltlab.evaluate.mocap` (the motion-capture reference) and
+:mod:`~tiltlab.evaluate.mocap` (the motion-capture reference),
+:mod:`~tiltlab.evaluate.speed` (error against angular speed: slope, crossover) and
 :mod:`~tiltlab.evaluate.budget` (what bounds an estimate's error: its slow and fast
 parts, and how far estimates can differ).
 """
@@ -71,12 +72,14 @@ from .budget import error_budget
 from .mocap import mocap_reference
 from .recipes import best_params, estimator, pooled_errors, tilt_difference_rms
 from .selection import error_table, grid_search, loto, loto_summary, optimum
+from .speed import crossover_speed, speed_slope
 
 from .budget import __all__ as _budget_all
 from .errors import __all__ as _errors_all
 from .mocap import __all__ as _mocap_all
 from .recipes import __all__ as _recipes_all
 from .selection import __all__ as _selection_all
+from .speed import __all__ as _speed_all
 
 __all__ = [
     *_errors_all,
@@ -84,6 +87,7 @@ __all__ = [
     *_recipes_all,
     *_mocap_all,
     *_budget_all,
+    *_speed_all,
 ]
 
 
