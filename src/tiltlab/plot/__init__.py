@@ -17,7 +17,10 @@ Submodules
   per-trial bars, ECDFs, errors binned by speed;
 * :mod:`~tiltlab.plot.cohort` — Tukey boxplots and group means for cohort tables, mean-tilt
   trajectories with each baseline at the pole (Fig. 3e);
+* :mod:`~tiltlab.plot.immobility` — the angular-speed distribution split by an
+  immobility mask (Fayat Fig. A3);
 * :mod:`~tiltlab.plot.movement` — changes of heading and flight classes;
+* :mod:`~tiltlab.plot.benchmark` — gravity trajectories side by side (Fig. 2b);
 * :mod:`~tiltlab.plot.learning` — training curves and per-trial errors by method;
 * :mod:`~tiltlab.plot.tables` — :func:`table`, the table recipe: headers with units,
   rounding by quantity, p-values written once.
@@ -25,7 +28,13 @@ Submodules
 Everything is re-exported here: ``from tiltlab import plot; plot.kde_map(k)``.
 """
 
-from .calibration import mag_calibration_figure
+from .benchmark import tilt_trajectories_panels
+from .calibration import (
+    calibration_log_figure,
+    mag_calibration_figure,
+    norm_error_band_figure,
+)
+from .immobility import immobility_speed_distribution
 from .cohort import group_lines, tilt_trajectories_figure, tukey_boxplot
 from .filters import estimates_overview, plain_log_ticks, running_rms, tilt_angle_deg
 from .learning import learning_curves, method_strips
@@ -70,6 +79,7 @@ from .recording import (
 from .scores import binned_errors, ecdf_plot, score_curves, score_heatmap, trial_bars
 from .tables import DECIMALS, MAX_HEADER, MISSING, P_DECIMALS, table
 
+from .benchmark import __all__ as _benchmark_all
 from .cohort import __all__ as _cohort_all
 from .filters import __all__ as _filters_all
 from .learning import __all__ as _learning_all
@@ -81,6 +91,9 @@ from .scores import __all__ as _scores_all
 from .tables import __all__ as _tables_all
 
 __all__ = [
+    "calibration_log_figure",
+    "norm_error_band_figure",
+    "immobility_speed_distribution",
     *_recording_all,
     "SENSOR_AXES",
     *_maps_all,
@@ -91,4 +104,5 @@ __all__ = [
     *_movement_all,
     *_filters_all,
     *_tables_all,
+    *_benchmark_all,
 ]
