@@ -354,8 +354,9 @@ def mkde(
     cut into :math:`m_k=\lceil\omega_k/\mathrm{step}\rceil` equal sub-arcs; a kernel sits
     at the middle of each (:func:`slerp_vectors` at :math:`\alpha=(j+\tfrac12)/m_k`) with
     weight :math:`\Delta t_k/m_k`, so the density is the fraction of *time* spent near
-    each direction. With ``diffusion`` :math:`D` > 0 (rad²/s) the bandwidth grows inside
-    the step like a Brownian bridge, :math:`h^2(\alpha) = h^2 + \alpha(1-\alpha)D\Delta
+    each direction. With ``diffusion`` :math:`D` > 0 (rad²/s; variance :math:`2Dt` per
+    axis, the convention of :func:`tiltlab.sphere.brb`) the bandwidth grows inside the
+    step like a Brownian bridge, :math:`h^2(\alpha) = h^2 + 2\alpha(1-\alpha)D\Delta
     t_k` — a simplified, unbiased version of Benhamou's biased random bridges [3]_
     (:func:`tiltlab.sphere.brb` has the bridges with a minimal width, a fitted D and
     residence or visit weightings).
@@ -379,7 +380,7 @@ def mkde(
     step : float, optional
         Maximal sub-arc length (rad), default h/2.
     diffusion : float
-        Brownian-bridge diffusion coefficient (rad²/s), ≥ 0.
+        Brownian-bridge diffusion coefficient (rad²/s; variance 2Dt per axis), ≥ 0.
     max_gap : float
         Steps longer than this (s) are dropped (data gaps).
     **settings
@@ -415,7 +416,7 @@ def mkde(
     a, b, dt, om = _steps(x, t, max_gap)
     pts, alpha, k, mk = _sub_arcs(a, b, om, step)
     w = dt[k] / mk
-    hh = np.sqrt(h * h + alpha * (1 - alpha) * diffusion * dt[k])
+    hh = np.sqrt(h * h + 2.0 * alpha * (1 - alpha) * diffusion * dt[k])
     grid = _settings_grid(opts, x)
     return SphericalKDE(_scatter(pts, w, hh, grid, opts), grid, float(h))
 
