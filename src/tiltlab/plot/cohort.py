@@ -238,7 +238,7 @@ def tilt_trajectories_figure(
 ):
     r"""Draw mean-tilt trajectories with each baseline at the pole (Fayat Fig. 3e).
 
-    One panel per group, seen from above the pole in the Lambert azimuthal equal-area
+    One panel per group (two per row), seen from above the pole in the Lambert azimuthal equal-area
     projection (:math:`X = \sqrt{2/(1+z)}\,x`, :math:`Y = \sqrt{2/(1+z)}\,y`): each
     animal's trajectory in grey, the group's mean direction in red with its time
     first, last and farthest time points labelled, circles at constant angles from the
@@ -257,7 +257,7 @@ def tilt_trajectories_figure(
     Returns
     -------
     matplotlib.figure.Figure
-        The figure (one axes per group).
+        The figure (one visible axes per group, in rows of two).
 
     Raises
     ------
@@ -296,11 +296,15 @@ def tilt_trajectories_figure(
     )
     rings = [r for r in _RINGS_DEG if r <= 1.05 * largest][-4:] or [_RINGS_DEG[0]]
     edge = 1.15 * 2 * np.sin(np.radians(max(rings[-1], largest)) / 2)
+    ncols = min(len(groups), 2)  # the book's 8.4-inch text width
+    nrows = -(-len(groups) // ncols)
     fig, axes = plt.subplots(
-        1, len(groups), figsize=(3.2 * len(groups), 3.4), squeeze=False
+        nrows, ncols, figsize=(4.2 * ncols, 4.0 * nrows), squeeze=False
     )
+    for ax in axes.flat[len(groups) :]:
+        ax.set_visible(False)
     t = np.linspace(0, 2 * np.pi, 200)
-    for ax, g in zip(axes[0], groups):
+    for ax, g in zip(axes.flat, groups):
         for r in rings:
             rr = 2 * np.sin(np.radians(r) / 2)
             ax.plot(rr * np.cos(t), rr * np.sin(t), color="0.85", lw=0.8, zorder=0)
