@@ -259,8 +259,40 @@ def check(nb_path: Path, params: dict) -> str:
     summary = _check_summary(nb_path, params, has_gyr=True)
     return (
         f"{got:.1%} of {params['SOURCE']} below {threshold:g} °/s "
-        f"(package: {expected:.1%}); {summary}"
+        f"(package: {expected:.1%}); {summary}; {_check_a3(nb_path, real, params)}"
     )
+
+
+def _check_a3(nb_path: Path, real, params: dict) -> str:
+    """Fig. A3: the printed shares of samples that the immobility rules reclassify
+    (below the threshold but moving, above it but immobile), recomputed with
+    ``behavior.detect_immobility`` on the recording's angular speed."""
+    import numpy as np
+
+    from tiltlab import behavior
+
+    thr = params["THRESHOLD_DEG_S"]
+    speed = behavior.recording_speed(real)
+    gaps = ~np.isfinite(speed.values)
+    still = np.asarray(
+        behavior.detect_immobility(speed.fillna(1e9), threshold_deg_s=thr)
+    )
+    below = (speed.values < thr) & ~gaps
+    above = (speed.values >= thr) & ~gaps
+    want = (
+        100 * float((below & ~still).sum() / max(below.sum(), 1)),
+        100 * float((above & still).sum() / max(above.sum(), 1)),
+    )
+    found = printed(
+        nb_path,
+        r"([0-9.]+) % of the samples below the threshold are moving after the rules, "
+        r"([0-9.]+) % of those above it immobile",
+        "Fig. A3 reclassification line",
+    )
+    got = tuple(float(v) for v in found[0])
+    if any(abs(a - b) > 0.051 for a, b in zip(got, want)):
+        raise AssertionError(f"Fig. A3 line says {got} %, recomputed {want} %")
+    return f"Fig. A3: {got[0]:.1f} % / {got[1]:.1f} % reclassified (package agrees)"
 
 
 def prepare_tag(tmp: Path) -> dict:

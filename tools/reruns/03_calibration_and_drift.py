@@ -63,8 +63,30 @@ def check(nb_path: Path, params: dict) -> str:
     return (
         f"{len(intervals)} still periods, first-pass gyro offset "
         f"{np.round(expected, 2).tolist()} deg/s (package agrees); {notes}; "
-        f"{_check_lacanna(values)}"
+        f"{_check_lacanna(values)}; {_check_fig1(values, params)}"
     )
+
+
+def _check_fig1(values: dict, params: dict) -> str:
+    """Fig. 1b and 1e: the offset correction lowers the median norm error, the log
+    holds one calibration per date asked, and each sensor's largest offset spread over
+    the year equals its glued ratio times the fits' largest error against the truth."""
+    raw = glued_float(values, "ch3_band_raw_mg")
+    corr = glued_float(values, "ch3_band_corr_mg")
+    if not corr < raw:
+        raise AssertionError(f"corrected error {corr} mg is not below raw {raw} mg")
+    n = int(glued_float(values, "ch3_log_n"))
+    if n != params.get("LOG_DATES", n):
+        raise AssertionError(f"the log holds {n} calibrations, LOG_DATES asked another")
+    for s in ("acc", "gyr"):
+        spread = glued_float(values, f"ch3_log_{s}_spread")
+        ratio = glued_float(values, f"ch3_log_{s}_ratio_true")
+        err = glued_float(values, f"ch3_log_{s}_fit_err")
+        if abs(spread - ratio * err) > 1e-6 * max(1.0, abs(spread)):
+            raise AssertionError(
+                f"{s}: spread {spread} is not {ratio} x fit error {err}"
+            )
+    return f"Fig. 1b: {raw:.1f} -> {corr:.1f} mg; Fig. 1e: {n} calibrations"
 
 
 def _check_lacanna(values: dict) -> str:
