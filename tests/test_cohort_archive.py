@@ -1,6 +1,5 @@
 """Saved feature tables of several configurations, read only when their digests match."""
 
-import hashlib
 import json
 
 import numpy as np
@@ -8,7 +7,7 @@ import pandas as pd
 import pytest
 import xarray as xr
 
-from tiltlab import cohort
+from tiltlab import cohort, io
 from tiltlab.io import IntegrityError
 
 
@@ -28,10 +27,7 @@ def _write(folder, names=("default", "fayat2021"), truth=True):
         )
         lines.append("truth.csv")
     (folder / "run.json").write_text(json.dumps({"seed": 0}))
-    sums = "".join(
-        f"{hashlib.sha256((folder / n).read_bytes()).hexdigest()}  {n}\n" for n in lines
-    )
-    (folder / "SHA256SUMS").write_text(sums)
+    io.write_sums(folder, {n: io.file_sha256(folder / n) for n in lines})
 
 
 def test_round_trip_of_every_table_truth_and_run(tmp_path):
@@ -65,11 +61,15 @@ def test_a_changed_or_missing_file_is_refused_by_name(tmp_path):
 def test_bad_folders_are_named(tmp_path):
     with pytest.raises(FileNotFoundError, match="no cohort archive folder"):
         cohort.read_feature_archive(tmp_path / "nope")
-    with pytest.raises(FileNotFoundError, match="no SHA256SUMS"):
+    with pytest.raises(IntegrityError, match="no SHA256SUMS"):
         cohort.read_feature_archive(tmp_path)
     (tmp_path / "SHA256SUMS").write_text("not a digest line\n")
     with pytest.raises(ValueError, match="line 1"):
         cohort.read_feature_archive(tmp_path)
     (tmp_path / "SHA256SUMS").write_text("")
+    with pytest.raises(IntegrityError, match="empty checksum file"):
+        cohort.read_feature_archive(tmp_path)
+    (tmp_path / "notes.txt").write_text("no tables here")
+    io.write_sums(tmp_path, {"notes.txt": io.file_sha256(tmp_path / "notes.txt")})
     with pytest.raises(ValueError, match="no features_"):
         cohort.read_feature_archive(tmp_path)

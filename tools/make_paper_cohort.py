@@ -20,7 +20,6 @@ cohort at this size. The output does not depend on ``--workers``.
 from __future__ import annotations
 
 import argparse
-import hashlib
 import json
 import platform
 import shutil
@@ -31,17 +30,9 @@ from pathlib import Path
 import numpy as np
 
 import tiltlab
-from tiltlab import cohort, simulate
+from tiltlab import cohort, io, simulate
 
 FILES = ("features_default.nc", "features_fayat2021.nc", "truth.csv")
-
-
-def _sha256(path: Path) -> str:
-    h = hashlib.sha256()
-    with open(path, "rb") as f:
-        for block in iter(lambda: f.read(1 << 20), b""):
-            h.update(block)
-    return h.hexdigest()
 
 
 def main() -> None:
@@ -111,8 +102,7 @@ def main() -> None:
         },
     }
     (out / "run.json").write_text(json.dumps(run, indent=1) + "\n")
-    lines = [f"{_sha256(out / n)}  {n}\n" for n in FILES]
-    (out / "SHA256SUMS").write_text("".join(lines))
+    io.write_sums(out, {n: io.file_sha256(out / n) for n in FILES})
     print(json.dumps(timings))
 
 

@@ -21,7 +21,6 @@ the file.
 from __future__ import annotations
 
 import functools
-import hashlib
 import json
 import os
 import re
@@ -31,6 +30,7 @@ from pathlib import Path
 import xarray as xr
 
 from . import io
+from .io.checksums import file_sha256
 
 __all__ = [
     "DataError",
@@ -138,27 +138,6 @@ def data_dir() -> Path | None:
     """
     d = os.environ.get(ENV_DATA_DIR)
     return Path(d).expanduser().resolve() if d else None
-
-
-def file_sha256(path: str | os.PathLike) -> str:
-    """Return the SHA-256 of a file's content, read in 1 MiB chunks.
-
-    Parameters
-    ----------
-    path : str or path
-        The file.
-
-    Returns
-    -------
-    str
-        The digest, 64 lowercase hexadecimal digits (``bytes.fromhex`` gives the raw
-        digest).
-    """
-    h = hashlib.sha256()
-    with open(path, "rb") as f:
-        for chunk in iter(lambda: f.read(1 << 20), b""):
-            h.update(chunk)
-    return h.hexdigest()
 
 
 @functools.lru_cache(maxsize=256)

@@ -12,20 +12,16 @@ match their digests.
 from __future__ import annotations
 
 import json
-import re
 from pathlib import Path
 from typing import Any, NamedTuple
 
 import pandas as pd
 import xarray as xr
 
-from ..datasets import file_sha256
-from ..io import IntegrityError
+from ..io.checksums import SUMS_FILE, check_sums
 from .run import load_features
 
 __all__ = ["FeatureArchive", "read_feature_archive"]
-
-_LINE = re.compile(r"^([0-9a-fA-F]{64}) [ *](\S.*)$")
 
 
 class FeatureArchive(NamedTuple):
@@ -62,57 +58,36 @@ def read_feature_archive(folder) -> FeatureArchive:
     Raises
     ------
     FileNotFoundError
-        A missing folder or ``SHA256SUMS``.
-    ValueError
-        A malformed ``SHA256SUMS`` line, or no ``features_*.nc`` listed in it.
+        A missing folder.
     tiltlab.io.IntegrityError
-        A listed file that is missing or whose digest differs (naming the file).
+        No ``SHA256SUMS``, a malformed one, or a listed file that is missing or whose
+        digest differs (naming the file; :func:`tiltlab.io.check_sums`).
+    ValueError
+        No ``features_*.nc`` listed in ``SHA256SUMS``.
 
     Examples
     --------
-    >>> import tempfile, hashlib, numpy as np, xarray as xr
+    >>> import tempfile, numpy as np, xarray as xr
     >>> from pathlib import Path
-    >>> from tiltlab import cohort
+    >>> from tiltlab import cohort, io
     >>> d = Path(tempfile.mkdtemp())
     >>> ds = xr.Dataset({"a": ("session", np.arange(2.0))}, coords={"session": ["s1", "s2"]})
     >>> _ = cohort.save_features(ds, d / "features_default.nc")
-    >>> h = hashlib.sha256((d / "features_default.nc").read_bytes()).hexdigest()
-    >>> _ = (d / "SHA256SUMS").write_text(f"{h}  features_default.nc\n")
+    >>> io.write_sums(d, {"features_default.nc": io.file_sha256(d / "features_default.nc")})
     >>> list(cohort.read_feature_archive(d).features)
     ['default']
     """
     folder = Path(folder)
-    sums = folder / "SHA256SUMS"
     if not folder.is_dir():
         raise FileNotFoundError(f"no cohort archive folder {str(folder)!r}")
-    if not sums.is_file():
-        raise FileNotFoundError(f"{str(folder)!r} has no SHA256SUMS to check its files")
-    listed = {}
-    for k, line in enumerate(sums.read_text().splitlines(), 1):
-        if not line.strip():
-            continue
-        m = _LINE.match(line)
-        if m is None:
-            raise ValueError(f"{sums}: line {k} is not '<sha256>  <file>': {line!r}")
-        listed[m.group(2)] = m.group(1).lower()
-    for name, digest in listed.items():
-        path = folder / name
-        if not path.is_file():
-            raise IntegrityError(f"{name} is listed in {sums} but missing", path=path)
-        got = file_sha256(path)
-        if got != digest:
-            raise IntegrityError(
-                f"{name}: sha256 {got} differs from {sums} ({digest}): the file is "
-                "corrupt or was altered",
-                path=path,
-            )
+    listed = check_sums(folder)
     tables = {
         n[len("features_") : -len(".nc")]: n
         for n in listed
         if n.startswith("features_") and n.endswith(".nc")
     }
     if not tables:
-        raise ValueError(f"{sums} lists no features_<name>.nc file")
+        raise ValueError(f"{folder / SUMS_FILE} lists no features_<name>.nc file")
     features = {k: load_features(folder / n) for k, n in sorted(tables.items())}
     truth = None
     if "truth.csv" in listed:

@@ -26,7 +26,7 @@ import numpy as np
 from numba import njit
 
 from .. import _validate as _v
-from ..datasets import file_sha256
+from ..io.checksums import SUMS_FILE, file_sha256, read_sums, write_sums
 from ._common import offset_vector, read_sensors, start_orientation
 from ._docs import shared_docs
 from ._shared_kernel import _attitude_step, _gravity_error, _unit_sample
@@ -45,7 +45,7 @@ __all__ = [
 #: format tag written into (and required in) every weights file
 FORMAT = "tiltlab.learned_gain/1"
 #: the name of the checksum file next to a weights file (``sha256sum`` format)
-SUMS_NAME = "SHA256SUMS"
+SUMS_NAME = SUMS_FILE
 #: standard gravity used to make the accelerometer features unitless (m/s²)
 G0 = 9.80665
 #: the causal features: (raw signal, smoothing time constant in s, log offset)
@@ -209,12 +209,8 @@ def save_gain_weights(weights: GainWeights, path: str | os.PathLike) -> str:
     path.write_text(json.dumps(doc, indent=1) + "\n")
     digest = file_sha256(path)
     sums = path.parent / SUMS_NAME
-    lines = sums.read_text().splitlines() if sums.exists() else []
-    lines = [
-        ln for ln in lines if ln.strip() and ln.split()[-1].lstrip("*") != path.name
-    ]
-    lines.append(f"{digest}  {path.name}")
-    sums.write_text("\n".join(sorted(lines, key=lambda s: s.split()[-1])) + "\n")
+    listed = read_sums(sums) if sums.exists() else {}
+    write_sums(path.parent, listed | {path.name: digest})
     return digest
 
 
@@ -251,11 +247,7 @@ def load_gain_weights(
                 f"gain weights {path.name!r}: no {SUMS_NAME} file next to it to verify "
                 "its checksum (pass sha256=... or save it with save_gain_weights)"
             )
-        found = {
-            ln.split()[-1].lstrip("*"): ln.split()[0]
-            for ln in sums.read_text().splitlines()
-            if ln.strip()
-        }
+        found = read_sums(sums)
         if path.name not in found:
             raise ValueError(f"gain weights {path.name!r} is not listed in {sums}")
         sha256 = found[path.name]

@@ -39,6 +39,7 @@ from ._common import IntegrityError, ReadError
 from .broad import read_broad
 from .c3d import c3d_path, read_c3d
 from .check import try_read
+from .checksums import SUMS_FILE, check_sums, file_sha256, read_sums, write_sums
 from .csv import (
     FS_RANGE,
     READ_GAP_POLICIES,
@@ -64,6 +65,11 @@ from .tagtools import read_tagtools, write_tagtools
 __all__ = [
     "ReadError",
     "IntegrityError",
+    "SUMS_FILE",
+    "file_sha256",
+    "read_sums",
+    "check_sums",
+    "write_sums",
     "NotRecordingError",
     "read",
     "detect",

@@ -37,8 +37,8 @@ from .. import evaluate
 from .. import filters
 from .. import quaternion as quat
 from .data import sequence
-from ..io import IntegrityError
-from .files import SUMS_FILE, load_model, read_sums, save, sha256, write_json
+from ..io.checksums import check_sums, write_sums
+from .files import load_model, save, sha256, write_json
 from .training import TrainConfig, closed_loop_estimate, closed_loop_estimates, train
 
 __all__ = [
@@ -407,11 +407,10 @@ def ablate(
 
 
 def _write_sums(out: Path) -> None:
-    names = sorted(
+    names = [
         p.name for p in out.iterdir() if p.suffix in (".pt", ".json") and p.is_file()
-    )
-    lines = [f"{sha256(out / n)}  {n}" for n in names]
-    (out / SUMS_FILE).write_text("\n".join(lines) + "\n")
+    ]
+    write_sums(out, {n: sha256(out / n) for n in names})
 
 
 def check_files(folder: str | Path) -> dict[str, str]:
@@ -435,28 +434,10 @@ def check_files(folder: str | Path) -> dict[str, str]:
     ------
     tiltlab.io.IntegrityError
         (a ``ValueError``) naming the first file that is missing or whose checksum
-        differs, or the line of ``SHA256SUMS`` that is malformed.
-    ValueError
-        If there is no ``SHA256SUMS``.
+        differs, the line of ``SHA256SUMS`` that is malformed, or a missing
+        ``SHA256SUMS`` (:func:`tiltlab.io.check_sums`).
     """
-    folder = Path(folder)
-    sums = folder / SUMS_FILE
-    if not sums.is_file():
-        raise ValueError(f"no {SUMS_FILE} in {folder}")
-    out = {}
-    for name, digest in read_sums(sums).items():
-        path = folder / name
-        if not path.is_file():
-            raise IntegrityError(f"{name} is listed in {sums} but missing", path=path)
-        got = sha256(path)
-        if got != digest:
-            raise IntegrityError(
-                f"{name}: sha256 {got} differs from {sums} ({digest}): the file is "
-                "corrupt or was altered",
-                path=path,
-            )
-        out[name] = got
-    return out
+    return check_sums(folder)
 
 
 @_deprecate.renamed(recording="rec")

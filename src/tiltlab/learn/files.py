@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import hashlib
 import json
-import re
 import warnings
 from pathlib import Path
 from typing import Any
@@ -20,6 +19,7 @@ from .._stack import user_stacklevel
 from .. import _deprecate
 from ..datasets import file_sha256
 from ..io import IntegrityError
+from ..io.checksums import SUMS_FILE, read_sums
 from .model import OrientationCNN
 from .training import TrainConfig, build_model
 
@@ -48,76 +48,6 @@ def sha256(path: str | Path) -> str:
         Hex digest (64 lower-case characters).
     """
     return file_sha256(path)
-
-
-#: Name of the checksum file of a model folder (``sha256sum`` format).
-SUMS_FILE = "SHA256SUMS"
-_SUMS_LINE = re.compile(r"([0-9A-Fa-f]{64}) ([ *])(.+)")
-
-
-def read_sums(path: str | Path) -> dict[str, str]:
-    """Parse a ``SHA256SUMS`` file (the format of ``sha256sum``): name -> sha256.
-
-    Each line is 64 hex digits, a space, then a space (text mode) or ``*`` (binary
-    mode), then the file name, relative to the file's folder. Blank lines are
-    ignored; anything else is an error.
-
-    Parameters
-    ----------
-    path : str or pathlib.Path
-        The ``SHA256SUMS`` file.
-
-    Returns
-    -------
-    dict
-        File name (str, relative to the file's folder) -> SHA-256 hex digest (str,
-        lower case).
-
-    Raises
-    ------
-    tiltlab.io.IntegrityError
-        (a ``ValueError`` and an ``OSError``) naming the file and the line: a
-        malformed line, a name listed twice, a name outside the folder (absolute, or
-        with ``..``), or no entry at all (an empty file); a missing or unreadable file.
-    """
-    path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise IntegrityError(
-            f"{path}: cannot read checksum file ({exc})", path=path
-        ) from None
-    out: dict[str, str] = {}
-    for number, line in enumerate(text.splitlines(), start=1):
-        if not line.strip():
-            continue
-        m = _SUMS_LINE.fullmatch(line)
-        if m is None:
-            shown = line if len(line) <= 80 else line[:77] + "..."
-            raise IntegrityError(
-                f"{path}, line {number}: malformed checksum line {shown!r}; expected "
-                "64 hex digits, two spaces (or a space and '*') and a file name",
-                path=path,
-            )
-        digest, _, name = m.groups()
-        parts = Path(name).parts
-        if Path(name).is_absolute() or ".." in parts or not parts:
-            raise IntegrityError(
-                f"{path}, line {number}: {name!r} is not a file name inside "
-                f"{path.parent}",
-                path=path,
-            )
-        if name in out:
-            raise IntegrityError(
-                f"{path}, line {number}: {name!r} is listed twice", path=path
-            )
-        out[name] = digest.lower()
-    if not out:
-        raise IntegrityError(
-            f"{path}: empty checksum file (no entries): nothing would be verified",
-            path=path,
-        )
-    return out
 
 
 def _state_digest(blob: dict[str, Any]) -> str:
