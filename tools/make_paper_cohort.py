@@ -11,7 +11,13 @@ the 406 sessions and the 58 tumble tests to a temporary folder like a lab's own 
 default configuration and with ``FeatureConfig.fayat2021()`` (the paper's
 definitions). Written to ``--out``: ``features_default.nc``,
 ``features_fayat2021.nc`` (:func:`tiltlab.cohort.save_features`), ``truth.csv``
-(the planted effects of every session), ``run.json`` (command, design, seed,
+(the planted effects of every session), the two figures of the paper that need the
+recordings, computed with the default configuration before the recordings are
+deleted — ``maps_default.nc`` (Figs 3c–d: the tilt maps of every group and time point
+averaged over all animals, :func:`tiltlab.cohort.group_tilt_maps`, time fractions
+stored as float32) and ``velocity_default.nc`` (Fig. A5: every group's example
+animal, :func:`tiltlab.cohort.circling_examples`, 1001 quantiles, float32) —,
+``run.json`` (command, design, seed,
 configurations, timings, versions) and ``SHA256SUMS``. The recordings themselves
 (about 20 GB) are deleted. Chapter 8 reads these tables instead of simulating the
 cohort at this size. The output does not depend on ``--workers``.
@@ -32,7 +38,37 @@ import numpy as np
 import tiltlab
 from tiltlab import cohort, io, simulate
 
-FILES = ("features_default.nc", "features_fayat2021.nc", "truth.csv")
+FILES = (
+    "features_default.nc",
+    "features_fayat2021.nc",
+    "truth.csv",
+    "maps_default.nc",
+    "velocity_default.nc",
+)
+
+
+def figures(manifest, features, config, design, out: Path, workers: int) -> None:
+    """Save the figures' data that need the recordings (Figs 3c–d and A5)."""
+    maps = cohort.group_tilt_maps(
+        manifest,
+        features,
+        config,
+        scheduler="processes" if workers > 1 else None,
+        workers=workers,
+        progress=True,
+    )
+    maps["fraction"] = maps["fraction"].astype(np.float32)
+    io.save_netcdf(maps, out / "maps_default.nc")
+    examples = cohort.circling_examples(
+        manifest,
+        features,
+        config,
+        groups=list(design.groups),
+        baseline=design.time_points[0],
+        compared=list(design.time_points[1:]),
+    )
+    examples["omega"] = examples["omega"].astype(np.float32)
+    io.save_netcdf(examples, out / "velocity_default.nc")
 
 
 def main() -> None:
@@ -81,6 +117,10 @@ def main() -> None:
                 raise RuntimeError(f"{failed} sessions failed with the {name} config")
             cohort.save_features(features, out / f"features_{name}.nc")
             timings[f"features_{name}_s"] = round(time.perf_counter() - t0, 1)
+            if name == "default":
+                t0 = time.perf_counter()
+                figures(manifest, features, config, design, out, args.workers)
+                timings["figures_default_s"] = round(time.perf_counter() - t0, 1)
         shutil.copyfile(folder / "truth.csv", out / "truth.csv")
     finally:
         shutil.rmtree(scratch, ignore_errors=True)

@@ -1,6 +1,7 @@
 """Chapter 8 on a small simulated cohort with other groups and time points, its design
-given as parameters as a lab would; and on a two-group, one-time-point cohort cut from
-another lab's accelerometer-only tag, with a session that fails."""
+given as parameters as a lab would; on a two-group, one-time-point cohort cut from
+another lab's accelerometer-only tag, with a session that fails; and on the small cohort
+the chapter simulates itself when it is not given the paper-scale one."""
 
 from __future__ import annotations
 
@@ -292,4 +293,45 @@ def check_foreign(nb_path: Path, params: dict) -> str:
     )
 
 
-VARIANTS = {"foreign": prepare_foreign}
+N_SMALL = 6
+
+
+def prepare_small(tmp: Path) -> dict:
+    """No manifest, ``SIMULATE``: the chapter simulates Fayat et al.'s design with six
+    animals per group and 1-min sessions in the run (§11 still reads the paper-scale
+    cohort)."""
+    return {
+        **SMALL,
+        "SIMULATE": True,
+        "N_PER_GROUP": N_SMALL,
+        "DURATION_S": 60.0,
+        "POWER_N": [3, 4, 6],
+    }
+
+
+def check_small(nb_path: Path, params: dict) -> str:
+    """The chapter simulated the five groups of the design with the requested animals
+    and seven time points, said so, and ran the Fayat blocks of tests; §11's agreement
+    count is the package's."""
+    from tiltlab import stats
+
+    groups, tests, n_features, post = _design_lines(nb_path)
+    expected = {g: N_SMALL for g in ("Kainate", "ShamKainate", "Arsanilate")}
+    expected |= {"ShamArsanilate": N_SMALL, "Healthy": N_SMALL}
+    if groups != expected or post != 6:
+        raise AssertionError(f"chapter analysed {groups} × {post} compared time points")
+    families = stats.FAYAT_DESIGN["families"]
+    n_between = sum(len(pairs) for pairs in families.values())
+    want = n_features * post * (n_between + len(groups))
+    if tests != want:
+        raise AssertionError(f"chapter computed {tests} tests, expected {want}")
+    said = glued(nb_path).get("ch8_cohort_md", "")
+    if f"{N_SMALL} animals per group, 60-s sessions" not in said:
+        raise AssertionError(f"the chapter says it analysed {said!r}")
+    return (
+        f"{tests} tests on the cohort simulated in the run ({said}); "
+        + _check_paper_scale(nb_path)
+    )
+
+
+VARIANTS = {"foreign": prepare_foreign, "small": prepare_small}

@@ -23,6 +23,10 @@ r"""Cohorts: from a lab's folder of sessions to one feature table (layer 7).
   ``dask.distributed``, one code path; a per-session disk cache; failed sessions
   recorded, never lost), :func:`summary`, :func:`save_features`,
   :func:`load_features`;
+* :mod:`~tiltlab.cohort.maps` — :func:`group_tilt_maps` (Figs 3c–d: tilt maps averaged
+  per group and time point), :func:`circling_example`, :func:`gravity_frame_velocity`
+  and :func:`velocity_quantiles` (Fig. A5: angular velocity in the head and the
+  gravity-aligned frames);
 * :mod:`~tiltlab.cohort.archive` — :func:`read_feature_archive` (saved feature tables
   of several configurations, each checked against its SHA-256);
 * :mod:`~tiltlab.cohort.trajectories` — :func:`tilt_trajectories` (Fig. 3e: each
@@ -59,6 +63,13 @@ from .labels import (
     feature_units,
 )
 from .lookup import load_session_tilt, session_row
+from .maps import (
+    circling_example,
+    circling_examples,
+    gravity_frame_velocity,
+    group_tilt_maps,
+    velocity_quantiles,
+)
 from .manifest import (
     OPTIONAL_COLUMNS,
     READERS,
@@ -98,6 +109,11 @@ __all__ = [
     "feature_label",
     "session_row",
     "load_session_tilt",
+    "group_tilt_maps",
+    "circling_example",
+    "circling_examples",
+    "gravity_frame_velocity",
+    "velocity_quantiles",
     "REQUIRED_COLUMNS",
     "OPTIONAL_COLUMNS",
     "READERS",

@@ -4,6 +4,9 @@ A cohort that takes too long to compute in a book build (Fayat et al.'s cohort a
 paper's scale, written by ``tools/make_paper_cohort.py``) is kept as a folder:
 ``features_<name>.nc`` (:func:`~tiltlab.cohort.save_features`, one per feature
 configuration), optionally ``truth.csv`` (the planted effects of a simulated cohort),
+``maps_<name>.nc`` and ``velocity_<name>.nc`` (Figs 3c–d and A5 of that
+configuration: :func:`~tiltlab.cohort.group_tilt_maps`,
+:func:`~tiltlab.cohort.circling_examples`, for figures that need the recordings),
 ``run.json`` (how it was made) and ``SHA256SUMS`` (``sha256sum`` format) listing
 every data file. :func:`read_feature_archive` refuses a folder whose files do not
 match their digests.
@@ -19,6 +22,7 @@ import pandas as pd
 import xarray as xr
 
 from ..io.checksums import SUMS_FILE, check_sums
+from ..io.netcdf import load_netcdf
 from .run import load_features
 
 __all__ = ["FeatureArchive", "read_feature_archive"]
@@ -35,11 +39,18 @@ class FeatureArchive(NamedTuple):
         Planted effects per session (indexed by ``session``), if saved.
     run : dict
         The folder's ``run.json`` (empty if absent).
+    maps : dict of str to xarray.Dataset
+        Configuration name → group-averaged tilt maps (``maps_<name>.nc``), if saved.
+    velocity : dict of str to xarray.Dataset
+        Configuration name → Fig. A5's angular velocity quantiles
+        (``velocity_<name>.nc``), if saved.
     """
 
     features: dict[str, xr.Dataset]
     truth: pd.DataFrame | None
     run: dict[str, Any]
+    maps: dict[str, xr.Dataset] = {}
+    velocity: dict[str, xr.Dataset] = {}
 
 
 def read_feature_archive(folder) -> FeatureArchive:
@@ -89,9 +100,17 @@ def read_feature_archive(folder) -> FeatureArchive:
     if not tables:
         raise ValueError(f"{folder / SUMS_FILE} lists no features_<name>.nc file")
     features = {k: load_features(folder / n) for k, n in sorted(tables.items())}
+    extra = {
+        kind: {
+            n[len(kind) + 1 : -len(".nc")]: load_netcdf(folder / n)
+            for n in sorted(listed)
+            if n.startswith(f"{kind}_") and n.endswith(".nc")
+        }
+        for kind in ("maps", "velocity")
+    }
     truth = None
     if "truth.csv" in listed:
         truth = pd.read_csv(folder / "truth.csv").set_index("session")
     run_path = folder / "run.json"
     run = json.loads(run_path.read_text()) if run_path.is_file() else {}
-    return FeatureArchive(features, truth, run)
+    return FeatureArchive(features, truth, run, extra["maps"], extra["velocity"])
