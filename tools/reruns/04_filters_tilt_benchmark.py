@@ -7,6 +7,8 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
+import numpy as np
+
 from ._common import glued, glued_float, printed
 
 _NUM = r"[-+]?[0-9.]+"
@@ -301,14 +303,16 @@ def check(nb_path: Path, params: dict) -> str:
     """The chapter's glued statements agree with the tables and lines they summarise,
     and the values recomputed with the package: §2's Madgwick error and ranks, the
     summary's LOTO winner, offline-versus-causal verdict, paired comparisons and LOTO
-    gaps, §5's crossover, offset reductions and Table 1 shape, the immobility
-    agreement, and exercise 2's fold count."""
+    gaps, §5's crossover, offset reductions and Table 1 shape, Fig. 2f's speed slopes
+    and crossover speed, the immobility agreement, and exercise 2's fold count."""
     values = glued(nb_path)
     return "; ".join(
         [
             _check_first_look(nb_path, params, values),
             _check_broad_summary(nb_path, values),
             _check_simulation(nb_path, values),
+            _check_speed_slopes(nb_path, values),
+            _check_crossover_speed(nb_path, values),
             _check_rat(nb_path, params, values),
             _check_exercises(nb_path, values),
             _check_c3d(nb_path, params),
@@ -376,8 +380,203 @@ def check_tag(nb_path: Path, params: dict) -> str:
             _check_rat(nb_path, params, values),
             _check_broad_summary(nb_path, values),
             _check_simulation(nb_path, values),
+            _check_speed_slopes(nb_path, values),
+            _check_crossover_speed(nb_path, values),
         ]
     )
 
 
 VARIANTS = {"tag": prepare_tag}
+
+
+def _html_tables(nb_path: Path, marker: str, before_glue: str) -> list[list[str]]:
+    """The rows (cell texts) of the last HTML table containing ``marker`` that the
+    chapter displays before the cell that glues ``before_glue``."""
+    import html
+    import json
+
+    found, glued_at = None, False
+    for cell in json.loads(nb_path.read_text())["cells"]:
+        for o in cell.get("outputs", []) if cell["cell_type"] == "code" else []:
+            if o.get("metadata", {}).get("scrapbook", {}).get("name") == before_glue:
+                glued_at = True
+            page = "".join(o.get("data", {}).get("text/html", ""))
+            if marker in page and not glued_at:
+                found = page
+        if glued_at:
+            break
+    if found is None:
+        raise AssertionError(f"the chapter shows no table of {marker!r}")
+    rows = []
+    for tr in re.findall(r"<tr[^>]*>(.*?)</tr>", found, flags=re.S):
+        cells = re.findall(r"<t[hd][^>]*>(.*?)</t[hd]>", tr, flags=re.S)
+        rows.append([html.unescape(re.sub(r"<[^>]+>", "", c)).strip() for c in cells])
+    return rows
+
+
+def _half_unit(text: str) -> float:
+    """Half a unit of the last digit a number is written with (its rounding error)."""
+    mant, _, exp = text.lower().partition("e")
+    decimals = len(mant.partition(".")[2])
+    return 0.5 * 10.0 ** (int(exp or 0) - decimals)
+
+
+def _cell(text: str) -> float:
+    return float(text) if re.fullmatch(r"[-+]?[0-9.]+(?:e[-+]?\d+)?", text) else np.nan
+
+
+_SCI = r"[-+]?[0-9.]+(?:e[-+]?\d+)?"
+
+
+def _check_speed_slopes(nb_path: Path, values: dict) -> str:
+    """§5 Fig. 2f: the glued slope sentence against Table 5.2 (``evaluate.speed_slope``
+    as displayed): the filters with the steepest and the flattest slope, their slopes,
+    the reference's slope, interval and relative size, each to the digits displayed;
+    every displayed slope inside its own interval."""
+    rows = _html_tables(
+        nb_path, "Theil–Sen slope of tilt error against speed", "ch4_slope_sentence"
+    )
+    per_tab = float(re.findall(r"per ([0-9.]+) deg/s", rows[0][1])[0])
+    tab = {r[0]: r[1:] for r in rows[2:] if len(r) == 6}
+    for m, (s, lo, hi, _, n) in tab.items():
+        t = _half_unit(s) + max(_half_unit(lo), _half_unit(hi))
+        if not _cell(lo) - t <= _cell(s) <= _cell(hi) + t or int(n) < 3:
+            raise AssertionError(f"Table 5.2: {m}'s slope {s} outside [{lo}, {hi}]")
+    ref = tab.pop("motion capture", None)
+    if ref is None or not tab:
+        raise AssertionError(f"Table 5.2 lacks the reference or the filters: {rows}")
+    text = values["ch4_slope_sentence"]
+    top, s_top, per, low, s_low, s_ref, r_lo, r_hi, pct = _one(
+        rf"error of ([a-z_]+) grows fastest with speed \(({_SCI})° per ([0-9.]+) °/s\) "
+        rf"and that of ([a-z_]+) least \(({_SCI})°\)\. The motion-capture reference's "
+        rf"own error changes by ({_SCI})° per [0-9.]+ °/s \(interval ({_SCI}) to "
+        rf"({_SCI})\), ([0-9]+)% of the largest",
+        text,
+        "slope sentence of Fig. 2f",
+    )
+    if float(per) != per_tab:
+        raise AssertionError(
+            f"Fig. 2f: sentence per {per} °/s, Table 5.2 per {per_tab}"
+        )
+    slope = {m: _cell(r[0]) for m, r in tab.items()}
+    tol = {m: _half_unit(r[0]) for m, r in tab.items()}
+    for name, said, pick in ((top, s_top, max), (low, s_low, min)):
+        best = pick(slope.values())
+        if name not in slope or abs(slope[name] - best) > tol[name] + max(tol.values()):
+            raise AssertionError(
+                f"Fig. 2f sentence names {name} ({said}); Table 5.2's slopes {slope} "
+                f"give {pick(slope, key=slope.get)}"
+            )
+        if abs(float(said) - slope[name]) > _half_unit(said) + tol[name]:
+            raise AssertionError(
+                f"Fig. 2f sentence: {name}'s slope {said}, Table 5.2 {tab[name][0]}"
+            )
+    for said, shown, what in zip((s_ref, r_lo, r_hi), ref[:3], ("slope", "lo", "hi")):
+        if abs(float(said) - _cell(shown)) > _half_unit(said) + _half_unit(shown):
+            raise AssertionError(
+                f"Fig. 2f sentence: reference {what} {said}, Table 5.2 {shown}"
+            )
+    big = max(abs(v) for v in slope.values())
+    rel = 100 * abs(_cell(ref[0])) / big
+    err = 100 * (_half_unit(ref[0]) + rel / 100 * max(tol.values())) / big
+    if abs(int(pct) - rel) > 0.5 + err:
+        raise AssertionError(
+            f"Fig. 2f sentence: reference slope {pct}% of the largest, Table 5.2 "
+            f"gives {rel:.1f}%"
+        )
+    return f"Fig. 2f slopes: {top} steepest, {low} flattest, reference {pct}% (table)"
+
+
+def _crossing_spans(x, d, tol) -> list[tuple[float, float]]:
+    """Where ``evaluate.crossover_speed``'s interpolation of a first rise of ``d`` from
+    below zero to above can fall when each ``d`` is known only to within ``tol``."""
+    spans = []
+    for i in range(len(d) - 1):
+        if (d[: i + 1] - tol[: i + 1] > 0).any() or d[i + 1] + tol[i + 1] < 0:
+            continue  # an earlier bin is surely above, or the next surely below
+        di = (d[i] - tol[i], min(d[i] + tol[i], 0.0))
+        dj = (max(d[i + 1] - tol[i + 1], 0.0), d[i + 1] + tol[i + 1])
+        s = [x[i] + (x[i + 1] - x[i]) * a / (a - b) for a in di for b in dj if a < b]
+        if len(s) < 4:  # both may be zero: the crossing may lie anywhere in the bin
+            s += [x[i], x[i + 1]]
+        spans.append((float(min(s)), float(max(s))))
+    return spans
+
+
+def _check_crossover_speed(nb_path: Path, values: dict) -> str:
+    """§5 Fig. 2f: the glued crossover sentence equals ``evaluate.crossover_speed`` run
+    on the binned medians the chapter displays (Madgwick's minus the EKF's): whether
+    they cross, which side Madgwick's stays or goes, the speed (within what the
+    displayed rounding allows), the number of sign changes and the word placing it
+    against Fayat et al.'s 100–150 °/s."""
+    from tiltlab import evaluate
+
+    rows = _html_tables(nb_path, "by angular speed, bin centre", "ch4_cross_sentence")
+    centres = np.array([float(c) for c in rows[0][1:]])
+    tab = {r[0]: r[1:] for r in rows[1:] if len(r) == len(rows[0])}
+    if "madgwick" not in tab or "ekf" not in tab:
+        raise AssertionError(f"the median table lacks madgwick or ekf: {list(tab)}")
+    a = np.array([_cell(c) for c in tab["madgwick"]])
+    b = np.array([_cell(c) for c in tab["ekf"]])
+    tol = np.array(
+        [_half_unit(x) + _half_unit(y) for x, y in zip(tab["madgwick"], tab["ekf"])]
+    )
+    cross = evaluate.crossover_speed(centres, a, b)
+    ok = np.isfinite(a - b)
+    x, d, tol = centres[ok], (a - b)[ok], tol[ok]
+    sure = np.abs(d) > tol + 1e-9  # the sign survives the displayed rounding
+    text = values["ch4_cross_sentence"]
+    if "do not cross" in text:
+        side = re.search(r"Madgwick's median stays (below|above) the EKF's", text)
+        if side is None:
+            if ok.sum() >= 2:
+                raise AssertionError(f"Fig. 2f: {text!r}, yet {ok.sum()} bins compare")
+            return "Fig. 2f crossover: too few bins (as displayed)"
+        wrong = np.sign(d[sure]) != (-1 if side.group(1) == "below" else 1)
+        if wrong.any() or (sure.all() and np.isfinite(float(cross))):
+            raise AssertionError(
+                f"Fig. 2f says {text!r}; evaluate.crossover_speed on the displayed "
+                f"medians: {float(cross):.0f} °/s, {cross.attrs['reason']}"
+            )
+        return f"Fig. 2f crossover: none, Madgwick {side.group(1)} (package agrees)"
+    c_said, n_said, where, lo_f, hi_f = _one(
+        r"rises above the EKF's at (\d+) °/s .*?(\d+) sign change\(s\) in all\), "
+        r"(inside|below|above) their range of ([0-9.]+)–([0-9.]+)",
+        text,
+        "crossover sentence of Fig. 2f",
+    )
+    c_said, lo_f, hi_f = float(c_said), float(lo_f), float(hi_f)
+    want = (
+        "inside" if lo_f <= c_said <= hi_f else ("below" if c_said < lo_f else "above")
+    )
+    if where != want:
+        raise AssertionError(f"Fig. 2f: {c_said:g} °/s is {want} {lo_f:g}–{hi_f:g}")
+    if not sure.all():  # a tie at the displayed digits: the package's value is one
+        spans = _crossing_spans(x, d, tol)  # of many; where could the first one be?
+        if not any(lo - 0.5 <= c_said <= hi + 0.5 for lo, hi in spans):
+            raise AssertionError(
+                f"Fig. 2f says {text!r}; within the rounding of the displayed medians "
+                f"Madgwick's can first rise above the EKF's only in {spans} °/s"
+            )
+        return f"Fig. 2f crossover {c_said:g} °/s (ties in the display: within {spans})"
+    c = float(cross)
+    if np.isnan(c) or cross.attrs["reason"] != "a goes above b":
+        raise AssertionError(
+            f"Fig. 2f says {text!r}; evaluate.crossover_speed on the displayed medians "
+            f"(a = Madgwick, b = EKF): {c:.0f} °/s, {cross.attrs['reason']}"
+        )
+    i = int(np.flatnonzero(np.sign(d[:-1]) != np.sign(d[1:]))[0])
+    corners = [
+        x[i] + (x[i + 1] - x[i]) * di / (di - dj)
+        for di in (d[i] - tol[i], d[i] + tol[i])
+        for dj in (d[i + 1] - tol[i + 1], d[i + 1] + tol[i + 1])
+    ]
+    if not min(corners) - 0.5 <= c_said <= max(corners) + 0.5 or int(n_said) != int(
+        cross.attrs["n_crossings"]
+    ):
+        raise AssertionError(
+            f"Fig. 2f says {text!r}; evaluate.crossover_speed on the displayed medians: "
+            f"{c:.1f} °/s ({min(corners):.1f}–{max(corners):.1f} within the rounding), "
+            f"{cross.attrs['n_crossings']} sign change(s)"
+        )
+    return f"Fig. 2f crossover {c_said:g} °/s (package on the medians: {c:.1f})"

@@ -49,7 +49,11 @@ def check(nb_path: Path, params: dict) -> str:
         raise AssertionError(f"chapter used the rule {rule!r}")
     g = filters.gravity(q)[valid]
     notes = _prose(nb_path, params, g, immobile[valid].values)
-    return f"immobile fraction {got:.1%} (package: {expected:.1%}; {rule.strip()}); {notes}"
+    bridges = _check_sparse_bridges(nb_path, params, g)
+    return (
+        f"immobile fraction {got:.1%} (package: {expected:.1%}; {rule.strip()}); "
+        f"{notes}; {bridges}"
+    )
 
 
 def _close(got: float, expected: float, what: str, rel: float = 1e-6) -> None:
@@ -113,6 +117,62 @@ def _prose(nb_path: Path, params: dict, g, immobile: np.ndarray) -> str:
     return (
         f"prose: count/area within {max(rel):.2%}, MKDE–LKDE {pct:.2f} % "
         f"({v['ch6_mkde_verdict']}), thirds {st3.attrs['max_angle_deg']:.1f}°"
+    )
+
+
+def _check_sparse_bridges(nb_path: Path, params: dict, g) -> str:
+    """§6, sparse fixes: the glued L1 distances to the full-rate LKDE (densest row: the
+    largest of the three; sparsest row: each estimate) and step / h equal
+    ``sphere.kde_distance`` recomputed with ``sphere.kde``, ``sphere.brb_diffusion``
+    and ``sphere.brb`` on the chapter's subsampled tilt, and the comparison words (the
+    bridges closer or not, the closest estimate, the fitted D farther or not) follow."""
+    from tiltlab import sphere
+
+    v = glued(nb_path)
+    fs = float(g.attrs["fs"])
+    kl = sphere.kde(g, cell_deg=params.get("CELL_DEG", 1.0))
+    steps = params.get("SPARSE_STEPS_S", [0.1, 0.5, 1.0])
+    rows = []
+    for every in (steps[0], steps[-1]):
+        st = max(1, round(every * fs))
+        gs = g.isel(time=slice(None, None, st)).assign_attrs(fs=fs / st)
+        d_ml = sphere.brb_diffusion(gs, h_min=kl.h)
+        est = [
+            sphere.kde(gs, h=kl.h, grid=kl.grid),
+            sphere.brb(gs, h_min=kl.h, diffusion=0.0, grid=kl.grid),
+            sphere.brb(gs, h_min=kl.h, diffusion=d_ml, grid=kl.grid),
+        ]
+        step = float(np.median(sphere.angle(gs.values[:-1], gs.values[1:])))
+        rows.append([step / kl.h, *(sphere.kde_distance(e, kl) for e in est)])
+    (r0, *l1_dense), (r1, lk, b0, bd) = rows
+    for name, want in (
+        ("ch6_sparse_dense_ratio", r0),
+        ("ch6_sparse_dense_l1", max(l1_dense)),
+        ("ch6_sparse_far_ratio", r1),
+        ("ch6_sparse_far_lkde", lk),
+        ("ch6_sparse_far_b0", b0),
+        ("ch6_sparse_far_bd", bd),
+    ):
+        _close(glued_float(v, name), want, f"{name} (sphere.kde_distance)", rel=1e-5)
+    verdict = "closer to" if b0 < lk else "no closer to"
+    if v["ch6_sparse_bridge_verdict"].strip() != verdict:
+        raise AssertionError(
+            f"chapter says the kernels along the arcs are "
+            f"{v['ch6_sparse_bridge_verdict']!r} the full-rate LKDE; the L1 distances "
+            f"give {verdict!r} ({b0:.4f} vs {lk:.4f})"
+        )
+    closest = ("location-based", "along the arcs", "biased random bridges")[
+        int(np.argmin([lk, b0, bd]))
+    ]
+    _word(v["ch6_sparse_closest"], closest, "the closest estimate is the")
+    _word(
+        v["ch6_sparse_bd_words"],
+        "are farther from it" if bd > b0 else "come closer to it",
+        "the fitted-D bridges",
+    )
+    return (
+        f"sparse fixes: L1 LKDE/arcs/bridges {lk:.3f}/{b0:.3f}/{bd:.3f} "
+        f"(sphere.kde_distance, as glued)"
     )
 
 

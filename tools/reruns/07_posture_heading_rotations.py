@@ -59,7 +59,7 @@ def check(nb_path: Path, params: dict) -> str:
     notes = _prose(nb_path, params)
     return (
         f"median |yaw| per {params['GYRO_STEP_S']:g} s step {got:.3f}° "
-        f"(package: {expected:.3f}°); {notes}"
+        f"(package: {expected:.3f}°); {notes}; {_check_kestrel(nb_path, params)}"
     )
 
 
@@ -103,7 +103,7 @@ def check_tag(nb_path: Path, params: dict) -> str:
     notes = _prose(nb_path, params)
     return (
         f"circular mean magnetic azimuth {got:.2f}° over {n} samples "
-        f"(package: {expected:.2f}°); {notes}"
+        f"(package: {expected:.2f}°); {notes}; {_check_kestrel(nb_path, params)}"
     )
 
 
@@ -177,6 +177,136 @@ def _prose(nb_path: Path, params: dict) -> str:
     return (
         f"prose: Fig. 2 {n2}/5, Fig. 3 {n3}/2, median elevation {elev:.1f}°, "
         f"CV flapping/gliding {np.median(cv[flap]):.2f}/{np.median(cv[~flap]):.2f}"
+    )
+
+
+def _html_table(nb_path: Path, marker: str, before_glue: str) -> dict[str, list[str]]:
+    """Row label → cell texts of the last HTML table with a header cell ``marker``
+    that the chapter displays before the cell that glues ``before_glue``; the header
+    row under the key ``""``."""
+    import html
+    import json
+    import re
+
+    found = None
+    for cell in json.loads(nb_path.read_text())["cells"]:
+        outs = cell.get("outputs", []) if cell["cell_type"] == "code" else []
+        names = {o.get("metadata", {}).get("scrapbook", {}).get("name") for o in outs}
+        for o in outs:
+            page = "".join(o.get("data", {}).get("text/html", ""))
+            if f">{marker}<" in page:
+                found = page
+        if before_glue in names:
+            break
+    if found is None:
+        raise AssertionError(f"the chapter shows no table with a column {marker!r}")
+    rows = {}
+    for tr in re.findall(r"<tr[^>]*>(.*?)</tr>", found, flags=re.S):
+        cells = re.findall(r"<t[hd][^>]*>(.*?)</t[hd]>", tr, flags=re.S)
+        cells = [html.unescape(re.sub(r"<[^>]+>", "", c)).strip() for c in cells]
+        rows.setdefault(cells[0], cells[1:])
+    return rows
+
+
+def _check_kestrel(nb_path: Path, params: dict) -> str:
+    """§11, kestrel behaviours: the glued agreements, the misclassified windows (glued
+    and printed) and the time-budget table equal ``trig.classify_flight`` and
+    ``trig.flight_time_budget`` recomputed on the same simulated heave and session.
+
+    The chapter adds a 2° posture noise drawn from its shared generator, whose state
+    this check cannot replay; the labels depend on φ only through each window's mean
+    against ``LEVEL_TOL_DEG``, so the check uses the noise-free φ and first asserts that
+    every window mean lies more than ten standard errors of that noise from the
+    tolerance (then no draw of the noise can change a label)."""
+    import numpy as np
+    import pandas as pd
+    import xarray as xr
+
+    from tiltlab import simulate, trig
+
+    p = {
+        "FLAP_PERIOD_S": 0.18,
+        "KESTREL_SEG_S": 10.0,
+        "PERCH_DEG": 40.0,
+        "LEVEL_TOL_DEG": 20.0,
+        "SEED": 0,
+    } | params
+    fs, heave_s, seed = 100.0, 20.0, p["SEED"]  # as in the chapter's §11
+    heave = simulate.simulate_heave(heave_s, fs, period_s=p["FLAP_PERIOD_S"], rng=seed)
+    cls_fg = trig.classify_flight(heave, 0.0 * heave.values, level=1.0, window_s=1.0)
+    n_seg = int(p["KESTREL_SEG_S"] * fs)
+    beats = np.repeat([True, False], n_seg)
+    sim_a = simulate.simulate_heave(
+        2 * p["KESTREL_SEG_S"],
+        fs,
+        flapping=beats,
+        period_s=0.11,
+        glide_sd=0.05,
+        rng=seed,
+    )
+    sim_b = simulate.simulate_heave(
+        2 * p["KESTREL_SEG_S"],
+        fs,
+        flapping=beats,
+        period_s=p["FLAP_PERIOD_S"],
+        rng=seed + 1,
+    )
+    kestrel = xr.concat(
+        [sim_a, sim_b.assign_coords(time=sim_b.time + 2 * p["KESTREL_SEG_S"])], "time"
+    )
+    truth = np.repeat(["hover", "perched", "flap", "glide"], n_seg)
+    phi = np.where(truth == "perched", np.radians(p["PERCH_DEG"]), 0.0)
+    cls = trig.classify_flight(
+        kestrel, phi, level=1.0, window_s=1.0, level_tol_deg=p["LEVEL_TOL_DEG"]
+    )
+    margin = np.abs(np.abs(np.degrees(cls.elevation.values)) - p["LEVEL_TOL_DEG"])
+    if margin.min() < 10 * 2.0 / np.sqrt(fs):
+        raise AssertionError(
+            f"a window's mean elevation lies {margin.min():.2f}° from LEVEL_TOL_DEG: "
+            "the chapter's posture noise could change its label, this check cannot say"
+        )
+    labels = cls.behavior.values
+    win_truth = truth[: labels.size * int(fs)][:: int(fs)]
+    fg_truth = np.where(cls_fg.time.values < heave_s / 2, "flap", "glide")
+    v = glued(nb_path)
+    for name, want in (
+        ("ch7_kestrel_agree", 100 * float(np.mean(labels == win_truth))),
+        ("ch7_fg_agree", 100 * float(np.mean(cls_fg.behavior.values == fg_truth))),
+    ):
+        _close(glued_float(v, name), want, f"{name} (trig.classify_flight)")
+    pairs = pd.Series(list(zip(win_truth, labels)))
+    miss = pairs[pairs.str[0] != pairs.str[1]].value_counts()
+    want = {f"{n} {a} window(s) labelled {b}" for (a, b), n in miss.items()}
+    said = v["ch7_kestrel_miss"]
+    said = set() if said == "none is misclassified" else set(said.split("; "))
+    shown = printed(nb_path, r"misclassified windows: (.*)", "misclassified windows")
+    shown = set() if shown[0] == "none" else set(shown[0].split("; "))
+    if said != want or shown != want:
+        raise AssertionError(
+            f"§11 glues misclassified windows {sorted(said)} and prints {sorted(shown)}; "
+            f"trig.classify_flight gives {sorted(want)}"
+        )
+    table = _html_table(nb_path, "classified (s)", "ch7_kestrel_agree")
+    expected = {
+        "simulated (s)": pd.Series(truth).value_counts() / fs,
+        "classified (s)": trig.flight_time_budget(cls)["duration (s)"],
+        "classified, flap/glide heave (s)": trig.flight_time_budget(cls_fg)[
+            "duration (s)"
+        ],
+    }
+    for j, col in enumerate(table[""]):
+        for cls_name in trig.FLIGHT_CLASSES:
+            got = float(table[cls_name][j])
+            want_s = float(expected[col].get(cls_name, 0.0))
+            if abs(got - want_s) > 1e-6 * max(1.0, abs(want_s)):
+                raise AssertionError(
+                    f"§11 time budget: {cls_name}, {col} = {got:g}; "
+                    f"trig.flight_time_budget gives {want_s:g}"
+                )
+    n_bad = int(miss.sum())
+    return (
+        f"kestrel: {n_bad} of {labels.size} windows misclassified, budget as "
+        "trig.flight_time_budget"
     )
 
 
