@@ -8,6 +8,8 @@
   (:func:`tumble_test`, on :func:`tiltlab.sphere.fibonacci_lattice`);
 * :mod:`~tiltlab.simulate.mocap` — head markers and TTL synchronisation
   (:func:`mocap_markers`, :func:`simulate_mocap_session`);
+* :mod:`~tiltlab.simulate.study` — a motion-capture study: rats with their own sensor,
+  tumble-test calibration and session (:func:`mocap_study`);
 * :mod:`~tiltlab.simulate.cohort` — lesion cohorts on disk
   (:func:`simulate_cohort`, :func:`load_cohort`);
 * :mod:`~tiltlab.simulate.export` — a Recording written as a phone logger's export, one
@@ -64,6 +66,7 @@ from .cohort import (
     session_plan,
     simulate_cohort,
 )
+from .study import MocapRat, mocap_study
 from .track import Track, simulate_heave, simulate_track
 from .turntable import TurntableMotion, back_and_forth, radian_test
 import tiltlab.simulate.cohort as _cohort
@@ -71,6 +74,7 @@ import tiltlab.simulate.export as _export
 import tiltlab.simulate.kinematics as _kinematics
 import tiltlab.simulate.mocap as _mocap
 import tiltlab.simulate.sensor as _sensor
+import tiltlab.simulate.study as _study
 import tiltlab.simulate.track as _track
 import tiltlab.simulate.tumble as _tumble
 import tiltlab.simulate.turntable as _turntable
@@ -81,6 +85,7 @@ __all__ = [
     *_tumble.__all__,
     *_export.__all__,
     *_mocap.__all__,
+    *_study.__all__,
     *_cohort.__all__,
     *_track.__all__,
     *_turntable.__all__,
