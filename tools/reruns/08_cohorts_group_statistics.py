@@ -97,6 +97,7 @@ def _check_summary(nb_path: Path, params: dict) -> str:
             if tidy is not None:
                 counts[f"cells_{name}"] += int(tidy["p"].notna().sum())
                 counts[f"sig_{name}"] += int((tidy["p_paper"] < alpha).sum())
+    recovery = _check_recovery(nb_path, params, features, design, tables)
     for name, count in counts.items():
         if int(glued_float(values, f"ch8_{name}")) != count:
             raise AssertionError(
@@ -170,8 +171,56 @@ def _check_summary(nb_path: Path, params: dict) -> str:
             )
     return (
         f"glued counts match the package: {counts}; Wald/permutation agree on "
-        f"{agree} of {terms}"
+        f"{agree} of {terms}; {recovery}"
     )
+
+
+PLANTED = {
+    "immobile_fraction": "immobility_planted",
+    "tilt_immobile_sagittal_deg": "tilt_deg_planted",
+    "circling_index": "circling_cpm_planted",
+}
+
+
+def _check_recovery(nb_path: Path, params: dict, features, design, tables) -> str:
+    """§9: for every feature with a planted value, the glued count of found planted
+    differences, and the smallest found and largest missed sizes, are those of
+    ``stats.recovery_table`` recomputed from the cohort's ``truth.csv``."""
+    import pandas as pd
+
+    from tiltlab import cohort, stats
+
+    truth_path = Path(params["COHORT_MANIFEST"]).parent / "truth.csv"
+    if not truth_path.is_file():
+        return "no planted truth"
+    truth = pd.read_csv(truth_path).set_index("session")
+    sessions = stats.session_table(features).query("status == 'ok'")
+    sentence = glued(nb_path).get("ch8_recovery_sentence", "")
+    said = []
+    for feature, column in PLANTED.items():
+        t = stats.recovery_table(
+            tables[feature], truth[column], sessions, control=design.control, alpha=0.05
+        )
+        found, missed = t[t["found"]], t[~t["found"]]
+        want = [f"{cohort.feature_name(feature)}, {len(found)} of {len(t)}"]
+        if len(found) and len(missed) and missed["planted Δ"].abs().max() > 0:
+            want += [
+                f"{found['planted Δ'].abs().min():.4g}",
+                f"{missed['planted Δ'].abs().max():.4g}",
+            ]
+        lost = [w for w in want if w not in sentence]
+        if lost:
+            raise AssertionError(f"§9 says {sentence!r}; recomputed {want}")
+        said.append(want[0])
+    return "recovery as recomputed: " + "; ".join(said)
+
+
+def _check_not_paper_cohort(nb_path: Path) -> str:
+    """§11 says it analyses another cohort than §§2–10 when the chapter ran on its own."""
+    said = glued(nb_path).get("ch8_same_cohort_md", "").strip()
+    if said != "not the cohort of §§2–10":
+        raise AssertionError(f"§11 calls the paper-scale cohort {said!r} in this run")
+    return "§11: another cohort than §§2–10"
 
 
 def _nonfinite(a):
@@ -227,6 +276,8 @@ def check(nb_path: Path, params: dict) -> str:
         + _check_summary(nb_path, params)
         + "; "
         + _check_paper_scale(nb_path)
+        + "; "
+        + _check_not_paper_cohort(nb_path)
     )
 
 
@@ -290,6 +341,8 @@ def check_foreign(nb_path: Path, params: dict) -> str:
     return (
         f"{groups}, one time point, {tests} tests, failed session listed; "
         + _check_summary(nb_path, params)
+        + "; "
+        + _check_not_paper_cohort(nb_path)
     )
 
 
@@ -331,6 +384,8 @@ def check_small(nb_path: Path, params: dict) -> str:
     return (
         f"{tests} tests on the cohort simulated in the run ({said}); "
         + _check_paper_scale(nb_path)
+        + "; "
+        + _check_not_paper_cohort(nb_path)
     )
 
 
